@@ -1,0 +1,152 @@
+r"""Closed-form support functions of axisymmetric pressure on a disk.
+
+For a disk of radius ``R`` about the origin, a twist ``V = (v, w)`` rotates the patch about a
+centre at distance ``ρ = |v|/|w|``; with the moment function ``M(ρ) = ∫ p |x - c| dA`` (unit
+friction) the support function is ``h = |w| M(ρ)``, the force is ``M'(ρ) v̂`` and the moment
+``sign(w) (M - ρ M')``. With ``u = ρ/R``, ``x = 1/u²`` and
+``c_n = ((-1/2)_n / n!)²`` (the coefficients of the mean distance of a circle to a point,
+``₂F₁(-1/2, -1/2; 1; ·)``) every profile ``p ∝ (1 - r²/R²)^α`` gives outside the disk
+
+.. math:: M(ρ) = ρ \, {}_2F_1(-\tfrac12, -\tfrac12; α + 2; R^2/ρ^2),
+
+(thin ring: ``α + 2 → 1``), which is free of cancellation for far centres and smooth at
+``w = 0``. Inside the disk (``u < 1``, ``E``, ``K`` of modulus ``u``):
+
+- uniform: ``M = (2R/3) ₂F₁(-1/2, -3/2; 1; u²)``, ``M' = u ₂F₁(1/2, -1/2; 2; u²)``;
+- Hertz: ``M' = (3π/32) u (4 - u²)``, ``M - ρM' = (3π/16) R (1 - u² + 3u⁴/8)``;
+- parabolic: ``π M/R = [(608 + 192u² - 32u⁴) E - 16 (1 - u²)(23 + u²) K] / 225``,
+  ``π M' = 16 [(3 + 7u² - 2u⁴) E - (1 - u²)(3 + u²) K] / (45 u)`` (series below ``u = 0.3``);
+- thin ring: ``M' = (u/2) ₂F₁(1/2, 1/2; 2; u²)``, ``M - ρM' = (2R/π) E(u)``.
+
+These reproduce the forms of DESIGN.md §4 and were derived and checked against 30-digit
+quadrature; the parabolic form was found by exact fitting of its hypergeometric series.
+An annulus is a weighted difference of two uniform disks.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.special import ellipe, ellipk, hyp2f1, poch
+
+from fixplan.kernels import SupportKernel
+
+#: ``c`` of ``₂F₁(-1/2, -1/2; c; x)`` giving ``M(ρ)/ρ`` outside the disk, per profile.
+_OUTSIDE_C = {"uniform": 2.0, "hertz": 2.5, "parabolic": 3.0, "ring": 1.0}
+
+#: Below this ``u`` the parabolic force uses its power series (the E/K form cancels).
+_PARABOLIC_SERIES_BELOW = 0.3
+
+
+def _parabolic_series_coefficients(terms: int = 40) -> np.ndarray:
+    n = np.arange(terms, dtype=float)
+    c_n = (poch(-0.5, n) / np.array([math.factorial(int(k)) for k in n])) ** 2
+    return 4.0 * c_n * (1.0 / (3.0 - 2.0 * n) - 1.0 / (5.0 - 2.0 * n))
+
+
+_PARABOLIC_SERIES = _parabolic_series_coefficients()
+
+
+def _inside(profile: str, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Force ``M'`` and moment ``(M - ρM')/R`` per unit friction for ``0 <= u < 1``."""
+    u2 = u * u
+    if profile == "uniform":
+        force = u * hyp2f1(0.5, -0.5, 2.0, u2)
+        moment = (2.0 / 3.0) * hyp2f1(-0.5, -1.5, 1.0, u2) - u * force
+    elif profile == "hertz":
+        force = (3.0 * math.pi / 32.0) * u * (4.0 - u2)
+        moment = (3.0 * math.pi / 16.0) * (1.0 - u2 + 0.375 * u2 * u2)
+    elif profile == "ring":
+        force = 0.5 * u * hyp2f1(0.5, 0.5, 2.0, u2)
+        moment = (2.0 / math.pi) * ellipe(u2)
+    else:  # parabolic
+        e, k = ellipe(u2), ellipk(u2)
+        whole = (
+            (608.0 + 192.0 * u2 - 32.0 * u2 * u2) * e - 16.0 * (1.0 - u2) * (23.0 + u2) * k
+        ) / (225.0 * math.pi)
+        small = u < _PARABOLIC_SERIES_BELOW
+        force = np.empty_like(u)
+        big = ~small
+        ub, ub2 = u[big], u2[big]
+        force[big] = (16.0 / (45.0 * math.pi * ub)) * (
+            (3.0 + 7.0 * ub2 - 2.0 * ub2 * ub2) * e[big] - (1.0 - ub2) * (3.0 + ub2) * k[big]
+        )
+        n = np.arange(1, len(_PARABOLIC_SERIES))
+        us = u[small]
+        force[small] = (
+            (2.0 * n * _PARABOLIC_SERIES[1:])[None, :] * us[:, None] ** (2 * n - 1)[None, :]
+        ).sum(axis=1)
+        moment = whole - u * force
+    return force, moment
+
+
+@dataclass(frozen=True, slots=True)
+class DiskKernel(SupportKernel):
+    """Unit-friction support function of an axisymmetric ``profile`` on a disk of ``radius`` [m]
+    centred at the origin (``profile`` one of uniform, hertz, parabolic, ring)."""
+
+    radius: float
+    profile: str
+
+    @property
+    def size(self) -> float:
+        return self.radius
+
+    def evaluate(self, twists):
+        vx, vy, w = twists[:, 0], twists[:, 1], twists[:, 2]
+        speed = np.hypot(vx, vy)
+        spin = np.abs(w)
+        radius = self.radius
+        outside = speed >= radius * spin
+        h = np.empty(len(twists))
+        force = np.empty(len(twists))  # magnitude, along v̂
+        moment = np.empty(len(twists))  # signed, about the centre
+
+        a, t, wo = speed[outside], spin[outside], w[outside]
+        x = (radius * t / a) ** 2
+        c = _OUTSIDE_C[self.profile]
+        big_f = hyp2f1(-0.5, -0.5, c, x)
+        dbig_f = hyp2f1(0.5, 0.5, c + 1.0, x) / (4.0 * c)
+        h[outside] = a * big_f
+        force[outside] = big_f - 2.0 * x * dbig_f
+        moment[outside] = 2.0 * radius**2 * wo * dbig_f / a
+
+        inside = ~outside
+        a, t, wi = speed[inside], spin[inside], w[inside]
+        u = a / (radius * t)
+        f_in, m_in = _inside(self.profile, u)
+        h[inside] = t * radius * (m_in + u * f_in)
+        force[inside] = f_in
+        moment[inside] = np.sign(wi) * radius * m_in
+
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ex = np.where(speed > 0.0, vx / speed, 0.0)
+            ey = np.where(speed > 0.0, vy / speed, 0.0)
+        loads = np.column_stack([force * ex, force * ey, moment])
+        return h, loads
+
+
+@dataclass(frozen=True, slots=True)
+class AnnulusKernel(SupportKernel):
+    """Uniform pressure between ``inner_radius`` and ``radius`` [m]: two uniform disks."""
+
+    radius: float
+    inner_radius: float
+
+    @property
+    def size(self) -> float:
+        return self.radius
+
+    def _parts(self):
+        s2 = (self.inner_radius / self.radius) ** 2
+        outer = DiskKernel(self.radius, "uniform")
+        inner = DiskKernel(self.inner_radius, "uniform")
+        return (outer, 1.0 / (1.0 - s2)), (inner, -s2 / (1.0 - s2))
+
+    def evaluate(self, twists):
+        (outer, wo), (inner, wi) = self._parts()
+        ho, lo = outer.evaluate(twists)
+        hi, li = inner.evaluate(twists)
+        return wo * ho + wi * hi, wo * lo + wi * li

@@ -1,0 +1,206 @@
+r"""The inverse map of a limit surface: load → safety factor and motion.
+
+For a load ``L`` the safety factor is ``s(L) = min_{V: L·V = 1} h(V)`` and the minimising twist
+is the sliding motion (normality, maximum power). The minimisation runs in the normalised
+coordinates of the paper (force divided by the maximum force, moment by the maximum moment), as
+a damped Newton method on the plane ``L·V = 1`` started from the twist normal to the unit sphere
+(the paper's ellipsoid). The support function restricted to that plane is convex, so Newton with
+a backtracking line search converges from any start where ``h`` is smooth.
+
+Point supports make ``h`` kink where the centre of rotation meets a support point: the surface
+has a flat facet there. After Newton, the facets of the support points nearest to the found
+centre are tested exactly: a load lies on facet ``k`` when the force that point must carry to
+balance it is within its friction limit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fixplan.kernels import SupportKernel
+from fixplan.point_kernel import slowest_points
+from fixplan.tolerances import FACET_RTOL, INVERSE_MAX_ITERATIONS, INVERSE_RTOL
+
+#: Number of nearest support points whose facets are tested per query.
+_FACETS_TESTED = 3
+
+#: Newton decrement (relative to h) below which full steps are taken without a line search:
+#: there the iteration is quadratic and rounding would defeat the sufficient-decrease test.
+QUADRATIC_REGION = 1e-12
+
+#: Rounds of "push off the kink and run Newton again" for point supports.
+_FACET_RESTARTS = 4
+
+#: A support point whose weighted speed is below this fraction of h sits on a possible kink.
+_NEAR_KINK = 1e-6
+
+#: Size of that push, relative to the twist.
+_PUSH = 1e-3
+
+#: Most step halvings of the backtracking line search.
+_MAX_HALVINGS = 60
+
+
+@dataclass(frozen=True, slots=True)
+class InverseResult:
+    """Safety factors ``(K,)`` and unit normalised twists ``(K, 3)`` of a batch of loads."""
+
+    safety_factor: np.ndarray
+    twist: np.ndarray  # (vx, vy, w) in SI units, scaled later by the caller
+    on_facet: np.ndarray
+
+
+def _plane_basis(direction: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors ``(K, 3)`` orthogonal to unit ``direction`` and to each other."""
+    helper = np.zeros_like(direction)
+    axis = np.argmin(np.abs(direction), axis=1)
+    helper[np.arange(len(direction)), axis] = 1.0
+    e1 = np.cross(direction, helper)
+    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+    e2 = np.cross(direction, e1)
+    return e1, e2
+
+
+def _newton_step(g, hess, b1, b2):
+    """Newton step on the plane spanned by ``b1``, ``b2`` and its decrement ``gᵀ H⁻¹ g``."""
+    g1 = np.einsum("ij,ij->i", b1, g)
+    g2 = np.einsum("ij,ij->i", b2, g)
+    hb1 = np.einsum("ijk,ik->ij", hess, b1)
+    hb2 = np.einsum("ijk,ik->ij", hess, b2)
+    h11 = np.einsum("ij,ij->i", b1, hb1)
+    h12 = np.einsum("ij,ij->i", b1, hb2)
+    h22 = np.einsum("ij,ij->i", b2, hb2)
+    ridge = 1e-14 * np.abs(h11 + h22) + 1e-300
+    h11, h22 = h11 + ridge, h22 + ridge
+    det = h11 * h22 - h12 * h12
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s1 = -(h22 * g1 - h12 * g2) / det
+        s2 = -(h11 * g2 - h12 * g1) / det
+    decrement = -(g1 * s1 + g2 * s2)
+    bad = ~np.isfinite(decrement) | (decrement < 0.0) | (det <= 0.0)
+    # Steepest descent where the Hessian is unusable (never at a smooth minimum).
+    s1, s2 = np.where(bad, -g1, s1), np.where(bad, -g2, s2)
+    decrement = np.where(bad, g1 * g1 + g2 * g2, decrement)
+    return s1[:, None] * b1 + s2[:, None] * b2, decrement
+
+
+def _newton(z, e1, e2, active, terms, values) -> np.ndarray:
+    """Damped Newton on the planes, in place on rows ``active`` of ``z``; True where stalled."""
+    stalled = np.zeros(len(z), dtype=bool)
+    for _ in range(INVERSE_MAX_ITERATIONS):
+        if active.size == 0:
+            break
+        za, b1, b2 = z[active], e1[active], e2[active]
+        h, g, hess = terms(za)
+        step, decrement = _newton_step(g, hess, b1, b2)
+        done = decrement <= INVERSE_RTOL**2 * h
+        accepted = done | (decrement <= QUADRATIC_REGION * h)
+        t = np.ones(len(active))
+        for _ in range(_MAX_HALVINGS):
+            idx = np.flatnonzero(~accepted)
+            if idx.size == 0:
+                break
+            h_trial = values(za[idx] + t[idx, None] * step[idx])
+            ok = h_trial <= h[idx] - 1e-4 * t[idx] * decrement[idx]
+            accepted[idx[ok]] = True
+            t[idx[~ok]] *= 0.5
+        moved = accepted & ~done
+        z[active[moved]] = za[moved] + t[moved, None] * step[moved]
+        stalled[active[~accepted]] = True
+        active = active[moved]
+    stalled[active] = True
+    return stalled
+
+
+def solve(
+    kernel: SupportKernel, scale: float, loads: np.ndarray, units: np.ndarray
+) -> InverseResult:
+    """Safety factor and sliding twist of nonzero ``loads`` ``(K, 3)``.
+
+    ``scale`` multiplies the kernel (``mu * N``), ``units`` = ``(max_force, max_force,
+    max_moment)`` normalise the coordinates.
+    """
+    count = len(loads)
+    norm_loads = loads / units
+    length = np.linalg.norm(norm_loads, axis=1)
+    direction = norm_loads / length[:, None]
+    e1, e2 = _plane_basis(direction)
+    # Normalised twist Z has L̃·Z = 1; the SI twist is Z / units.
+    z = direction / length[:, None]
+
+    def terms(zs):
+        h, g, hess = kernel.newton_terms(zs / units)
+        g = g / units
+        hess = hess / units[:, None] / units[None, :]
+        return scale * h, scale * g, scale * hess
+
+    def values(zs):
+        return scale * kernel.support(zs / units)
+
+    stalled = _newton(z, e1, e2, np.arange(count), terms, values)
+    safety = values(z)
+    on_facet = np.zeros(count, dtype=bool)
+    points, friction = kernel.facets
+    if len(points):
+        for _ in range(_FACET_RESTARTS):
+            # Newton only stops short, or lands on a kink, next to a support point.
+            _, slowest = slowest_points(points, friction, z / units, 1)
+            near_kink = slowest[:, 0] <= _NEAR_KINK * safety
+            rows = np.flatnonzero((stalled | near_kink) & ~on_facet)
+            safety, found, push = _facets(
+                kernel, scale, loads, units, z, safety, points, friction, rows
+            )
+            on_facet |= found
+            # Newton stops at a kink that is not the minimum: push the stuck support point off
+            # its centre, in the direction it must slide, and start again from there.
+            retry = np.flatnonzero(stalled & ~on_facet & np.any(push != 0.0, axis=1))
+            if retry.size == 0:
+                break
+            z[retry] += push[retry]
+            z[retry] /= np.einsum("ij,ij->i", norm_loads[retry], z[retry])[:, None]
+            stalled[retry] = _newton(z, e1, e2, retry, terms, values)[retry]
+            safety[retry] = values(z[retry])
+    twist = z / units
+    return InverseResult(safety_factor=safety, twist=twist, on_facet=on_facet)
+
+
+def _facets(kernel, scale, loads, units, z, safety, points, friction, rows):
+    """Replace Newton's answer by an exact facet where the load lies on one (``z`` in place).
+
+    Only ``rows`` are tested. Also returns, per query, a push of ``z`` that makes the nearest
+    support point slide (for restarting Newton off a kink that is not the minimum).
+    """
+    on_facet = np.zeros(len(loads), dtype=bool)
+    push = np.zeros_like(z)
+    if rows.size == 0:
+        return safety, on_facet, push
+    nearest, _ = slowest_points(points, friction, z[rows] / units, _FACETS_TESTED)
+    for column in range(nearest.shape[1]):
+        k = nearest[:, column]
+        px, py = points[k, 0], points[k, 1]
+        facet_twist = np.column_stack([py, -px, np.ones(len(k))])
+        power = np.einsum("ij,ij->i", loads[rows], facet_twist)
+        facet_twist *= np.where(power < 0.0, -1.0, 1.0)[:, None]
+        power = np.abs(power)
+        usable = power > 0.0
+        h, g = kernel.evaluate(facet_twist)
+        h, g = scale * h, scale * g
+        s_k = np.where(usable, h / np.where(usable, power, 1.0), np.inf)
+        residual = s_k[:, None] * loads[rows, :2] - g[:, :2]
+        carried = np.hypot(residual[:, 0], residual[:, 1])
+        limit = scale * friction[k]
+        hit = (
+            usable & (carried <= limit * (1.0 + FACET_RTOL)) & (s_k <= safety[rows] * (1.0 + 1e-9))
+        )
+        hit_rows = rows[hit]
+        safety[hit_rows] = s_k[hit]
+        z[hit_rows] = facet_twist[hit] * units / power[hit, None]
+        on_facet[hit_rows] = True
+        if column == 0:
+            # Slide the nearest point along the force it would have to carry.
+            first = usable & ~hit & (carried > 0.0)
+            along = residual[first] / carried[first, None]
+            push[rows[first], :2] = _PUSH * along * units[:2] / power[first, None]
+    return safety, on_facet, push

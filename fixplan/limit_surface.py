@@ -1,0 +1,382 @@
+r"""The exact limit surface of a planar sliding contact.
+
+For a pressure field ``p`` (unit total), friction ``mu`` and normal force ``N`` the support
+(dissipation) function of a twist ``V = (vx, vy, w)`` is
+
+.. math:: h(V) = N \int \mu \, p \, |v(x)| \, dA, \qquad v(x) = (v_x - w y, v_y + w x),
+
+the load that sustains sliding with ``V`` is ``L(V) = ∇h(V)`` (paper eqs. 4-5) and the set of
+loads the contact holds is ``{L : L·V <= h(V) for all V}``, whose boundary is the limit surface.
+Loads ``(fx, fy, m)`` are the applied force [N] and moment [N m] about the field's origin;
+twists are ``(vx, vy, w)`` in [m/s] and [rad/s] (DESIGN.md §2).
+
+Accuracy (relative, measured by the tests against independent quadrature):
+
+- uniform, Hertz, parabolic, annulus and ring disks, uniform polygons and rectangles, and
+  tactile grids (piecewise-uniform cells): closed forms, about 1e-13 everywhere;
+- point supports: exact, facets included;
+- pressure functions and position-dependent ``mu``: adaptive quadrature centred at the centre
+  of rotation, better than 1e-9 for smooth integrands (1e-7 with a Hertz profile);
+- inverse map (safety factor, motion): Newton's method to 1e-12 on the twist, so the safety
+  factor matches the forward map to about 1e-15 and motions are within 1e-10 rad.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+
+import numpy as np
+
+from fixplan import validation
+from fixplan.disk_kernel import AnnulusKernel, DiskKernel
+from fixplan.errors import InvalidArgumentError
+from fixplan.geometry import Pose, triangulate
+from fixplan.inverse import solve
+from fixplan.kernels import PosedKernel, SumKernel, SupportKernel
+from fixplan.point_kernel import PointSetKernel
+from fixplan.polygon_kernel import EdgeSumKernel, polygon_edges
+from fixplan.pressure import (
+    DiskField,
+    FunctionField,
+    GridField,
+    PointsField,
+    PolygonField,
+    PressureField,
+)
+from fixplan.rules import gauss_jacobi_unit, triangle_rule
+from fixplan.sphere import circle, fibonacci_sphere
+from fixplan.tolerances import CONTAINMENT_RTOL
+
+#: Gauss order per triangle of the far-field rule of polygons (exact to machine precision for
+#: centres of rotation beyond FAR_FIELD_RADII patch radii).
+_FAR_ORDER = 12
+
+#: Loads are solved in chunks of this many to bound memory.
+_CHUNK = 4096
+
+_PLANES = {"fx-m": (0, 2), "fy-m": (1, 2), "fx-fy": (0, 1)}
+
+_PROFILE_PRESSURE: dict[str, Callable | None] = {
+    "uniform": None,
+    "hertz": lambda r2: np.sqrt(np.clip(1.0 - r2, 0.0, None)),
+    "parabolic": lambda r2: np.clip(1.0 - r2, 0.0, None),
+}
+
+
+class LimitSurface:
+    """Exact limit surface of a planar contact with pressure ``field``.
+
+    Parameters
+    ----------
+    field : PressureField
+        Pressure distribution, normalised to unit total; coordinates [m].
+    mu : float or callable
+        Friction coefficient, a constant >= 0 or a function ``mu(x, y)`` of contact-frame
+        coordinates [m] returning arrays.
+    normal_force : float
+        Total normal force [N], > 0.
+    """
+
+    __slots__ = ("_kernel", "_mu", "_normal_force", "_parts", "_scale", "_units", "field")
+
+    def __init__(self, field: PressureField, *, mu: float | Callable, normal_force: float = 1.0):
+        if not isinstance(field, PressureField):
+            raise InvalidArgumentError(
+                f"field must be a pressure field from fixplan.pressure, got {type(field).__name__}"
+            )
+        normal_force = validation.positive_scalar("normal_force", normal_force)
+        if callable(mu):
+            kernel, scale = _varying_friction_kernel(field, mu), normal_force
+        else:
+            mu = validation.positive_scalar("mu", mu)
+            kernel, scale = _field_kernel(field), mu * normal_force
+        self.field = field
+        self._mu = mu
+        self._normal_force = normal_force
+        self._parts: tuple[LimitSurface, ...] = ()
+        self._setup(kernel, scale)
+
+    def _setup(self, kernel: SupportKernel, scale: float) -> None:
+        self._kernel = kernel
+        self._scale = scale
+        probe = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+        max_force, max_moment = scale * kernel.support(probe)
+        self._units = np.array([max_force, max_force, max_moment])
+
+    @classmethod
+    def combine(cls, surfaces: Iterable[LimitSurface]) -> LimitSurface:
+        """Limit surface of rigidly connected patches: the Minkowski sum of ``surfaces``.
+
+        Its support function is the sum of the parts' (paper §4.4); all parts must be written
+        in the same contact frame. The result offers the same API; its ``field`` is ``None``.
+        """
+        parts = tuple(surfaces)
+        if not parts or not all(isinstance(p, LimitSurface) for p in parts):
+            raise InvalidArgumentError("combine needs one or more LimitSurface objects")
+        combined = cls.__new__(cls)
+        combined.field = None
+        combined._mu = None
+        combined._normal_force = sum(p.normal_force for p in parts)
+        combined._parts = parts
+        kernel = SumKernel(tuple(p._kernel for p in parts), tuple(p._scale for p in parts))
+        combined._setup(kernel, 1.0)
+        return combined
+
+    # -- description ------------------------------------------------------------------------
+
+    @property
+    def mu(self) -> float | Callable | None:
+        """Friction coefficient (``None`` for a combined surface)."""
+        return self._mu
+
+    @property
+    def normal_force(self) -> float:
+        """Total normal force [N] (summed over the parts of a combined surface)."""
+        return self._normal_force
+
+    @property
+    def parts(self) -> tuple[LimitSurface, ...]:
+        """The surfaces a combined surface was summed from (empty otherwise)."""
+        return self._parts
+
+    @property
+    def max_force(self) -> float:
+        """Largest friction force [N]: ``∫ mu p dA · N`` (pure translation, paper eq. 8)."""
+        return float(self._units[0])
+
+    @property
+    def max_moment(self) -> float:
+        """Largest friction moment about the origin [N m]: rotation about the origin."""
+        return float(self._units[2])
+
+    @property
+    def characteristic_length(self) -> float:
+        """``rho = max_moment / max_force`` [m], the scale of the paper's normalised plots."""
+        return self.max_moment / self.max_force
+
+    def __repr__(self) -> str:
+        what = f"{len(self._parts)} parts" if self._parts else type(self.field).__name__
+        return (
+            f"LimitSurface({what}, max_force={self.max_force:.6g} N, "
+            f"max_moment={self.max_moment:.6g} N m)"
+        )
+
+    # -- forward map ------------------------------------------------------------------------
+
+    def support(self, twist) -> np.ndarray | float:
+        """Support function ``h(V)`` [W per unit speed] of twists ``(3,)`` or ``(K, 3)``."""
+        twists, single = validation.vector_batch("twist", twist, width=3)
+        values = self._scale * self._kernel.support(twists)
+        return float(values[0]) if single else values
+
+    def load(self, twist) -> np.ndarray:
+        """Load ``(fx, fy, m)`` on the surface that sustains sliding with ``twist``.
+
+        ``twist`` is ``(3,)`` or ``(K, 3)``, nonzero. For a twist rotating about a point support
+        the stationary point carries no force (one point of the facet).
+        """
+        twists, single = validation.vector_batch("twist", twist, width=3)
+        zero = ~np.any(twists != 0.0, axis=1)
+        if np.any(zero):
+            raise InvalidArgumentError(
+                f"twist[{int(np.flatnonzero(zero)[0])}] is zero: a body at rest has no sliding load"
+            )
+        loads = self._scale * self._kernel.evaluate(twists)[1]
+        return loads[0] if single else loads
+
+    def load_at_cor(self, cor, ccw: bool = True) -> np.ndarray:
+        """Load for rotation about the centre of rotation ``cor`` ``(2,)`` or ``(K, 2)`` [m]."""
+        cors, single = validation.vector_batch("cor", cor, width=2)
+        sign = 1.0 if ccw else -1.0
+        twists = sign * np.column_stack([cors[:, 1], -cors[:, 0], np.ones(len(cors))])
+        loads = self.load(twists)
+        return loads[0] if single else loads
+
+    # -- inverse map ------------------------------------------------------------------------
+
+    def _inverse(self, load):
+        loads, single = validation.vector_batch("load", load, width=3)
+        safety = np.full(len(loads), np.inf)
+        twists = np.full((len(loads), 3), np.nan)
+        nonzero = np.flatnonzero(np.any(loads != 0.0, axis=1))
+        for start in range(0, len(nonzero), _CHUNK):
+            rows = nonzero[start : start + _CHUNK]
+            result = solve(self._kernel, self._scale, loads[rows], self._units)
+            safety[rows] = result.safety_factor
+            twists[rows] = result.twist
+        return safety, twists, single
+
+    def safety_factor(self, load) -> np.ndarray | float:
+        """Factor ``s`` with ``s * load`` on the surface (``inf`` for the zero load).
+
+        ``s > 1``: held with that margin; ``s < 1``: the contact slides.
+        """
+        safety, _, single = self._inverse(load)
+        return float(safety[0]) if single else safety
+
+    def contains(self, load) -> np.ndarray | bool:
+        """Whether the contact holds ``load`` (safety factor >= 1 - CONTAINMENT_RTOL)."""
+        safety, _, single = self._inverse(load)
+        held = safety >= 1.0 - CONTAINMENT_RTOL
+        return bool(held[0]) if single else held
+
+    def motion(self, load) -> np.ndarray:
+        """Unit twist of impending sliding under ``load`` (normality; NaN for the zero load).
+
+        For a load inside the surface it is the motion the load would cause if scaled up to the
+        surface. Scaled so that ``(vx, vy, rho * w)`` has unit norm,
+        ``rho = characteristic_length``.
+        """
+        _, twists, single = self._inverse(load)
+        return self._unit_twists(twists[0] if single else twists)
+
+    def motion_and_safety_factor(self, load) -> tuple[np.ndarray, np.ndarray | float]:
+        """:meth:`motion` and :meth:`safety_factor` from one solve."""
+        safety, twists, single = self._inverse(load)
+        if single:
+            return self._unit_twists(twists[0]), float(safety[0])
+        return self._unit_twists(twists), safety
+
+    def _unit_twists(self, twists: np.ndarray) -> np.ndarray:
+        scaled = twists * np.array([1.0, 1.0, self.characteristic_length])
+        return twists / np.linalg.norm(scaled, axis=-1, keepdims=True)
+
+    # -- plotting and fitting -----------------------------------------------------------------
+
+    def curve(self, plane: str = "fy-m", n: int = 361, *, normalized: bool = False) -> np.ndarray:
+        """Cross section of the surface by a coordinate plane, as loads ``(n, 3)``.
+
+        ``plane`` is ``"fx-m"``, ``"fy-m"`` or ``"fx-fy"`` (the third coordinate is zero); the
+        points are spread evenly in angle in normalised coordinates, counter-clockwise from the
+        first axis (paper Figs. 2, 3, 5). With ``normalized`` forces are divided by
+        ``max_force`` and moments by ``max_moment``.
+        """
+        axes = _PLANES.get(plane)
+        if axes is None:
+            raise InvalidArgumentError(f"plane must be one of {', '.join(_PLANES)}; got {plane!r}")
+        n = _count("n", n)
+        directions = np.zeros((n, 3))
+        directions[:, axes] = circle(n)
+        return self._radial(directions, normalized)
+
+    def sample(self, n: int = 1000, *, normalized: bool = False) -> np.ndarray:
+        """``n`` loads ``(n, 3)`` spread evenly over the whole surface (paper Fig. 4).
+
+        Directions are a Fibonacci lattice in normalised coordinates, each scaled onto the
+        surface; deterministic.
+        """
+        return self._radial(fibonacci_sphere(_count("n", n)), normalized)
+
+    def _radial(self, directions: np.ndarray, normalized: bool) -> np.ndarray:
+        loads = directions * self._units
+        loads = loads * self._inverse(loads)[0][:, None]
+        return loads / self._units if normalized else loads
+
+
+def _count(name: str, n: object) -> int:
+    if not isinstance(n, int | np.integer) or n < 1:
+        raise InvalidArgumentError(f"{name} must be a positive integer, got {n!r}")
+    return int(n)
+
+
+def _posed(kernel: SupportKernel, pose: Pose) -> SupportKernel:
+    return kernel if pose.is_identity else PosedKernel(kernel, pose)
+
+
+def _field_kernel(field: PressureField) -> SupportKernel:
+    """Unit-friction kernel of a field with constant friction: closed forms where they exist."""
+    if isinstance(field, DiskField):
+        if field.profile == "annulus":
+            local = AnnulusKernel(field.radius_m, field.inner_radius)
+        else:
+            local = DiskKernel(field.radius_m, field.profile)
+    elif isinstance(field, PolygonField):
+        starts, ends = polygon_edges(field.vertices)
+        far_points, far_weights = triangle_rule(triangulate(field.vertices), _FAR_ORDER)
+        local = EdgeSumKernel(
+            starts,
+            ends,
+            np.full(len(starts), 1.0 / field.area),
+            PointSetKernel(far_points, far_weights / far_weights.sum()),
+        )
+    elif isinstance(field, GridField):
+        local = _grid_kernel(field)
+    elif isinstance(field, PointsField):
+        local = PointSetKernel(field.xy, field.weights, discrete=True)
+    elif isinstance(field, FunctionField):
+        from fixplan.function_kernel import FunctionKernel
+
+        local = FunctionKernel(
+            regions=_regions(field.shape), pressure=field.function, friction=None
+        )
+    else:  # pragma: no cover - every field class is handled above
+        raise InvalidArgumentError(f"unsupported field type {type(field).__name__}")
+    return _posed(local, field.pose)
+
+
+def _grid_kernel(field: GridField) -> EdgeSumKernel:
+    centers, fractions = field.cells()
+    dx, dy = field.cell_size
+    corners = np.array([[-dx, -dy], [dx, -dy], [dx, dy], [-dx, dy]]) / 2.0
+    starts = (centers[:, None, :] + corners[None, :, :]).reshape(-1, 2)
+    ends = (centers[:, None, :] + np.roll(corners, -1, axis=0)[None, :, :]).reshape(-1, 2)
+    weights = np.repeat(fractions / (dx * dy), 4)
+    order = 8 if len(centers) <= 16 else 4 if len(centers) <= 256 else 3
+    t, wt = gauss_jacobi_unit(order)
+    ox, oy = np.meshgrid((t - 0.5) * dx, (t - 0.5) * dy, indexing="ij")
+    offsets = np.column_stack([ox.ravel(), oy.ravel()])
+    far_points = (centers[:, None, :] + offsets[None, :, :]).reshape(-1, 2)
+    far_weights = (fractions[:, None] * np.outer(wt, wt).ravel()[None, :]).ravel()
+    return EdgeSumKernel(starts, ends, weights, PointSetKernel(far_points, far_weights))
+
+
+def _regions(shape: DiskField | PolygonField) -> tuple:
+    """Regions of the function kernel covering a uniform disk or polygon shape."""
+    if isinstance(shape, DiskField):
+        return (("disk", shape.radius_m, 1.0),)
+    return (("polygon", np.asarray(shape.vertices), 1.0),)
+
+
+def _varying_friction_kernel(field: PressureField, mu: Callable) -> SupportKernel:
+    """Kernel of ``mu(x, y) * p`` (unit normal force) for position-dependent friction."""
+    pose = field.pose
+
+    def local_mu(x, y):
+        xy = pose.apply(np.column_stack([np.ravel(x), np.ravel(y)]))
+        values = np.asarray(mu(xy[:, 0], xy[:, 1]), dtype=float)
+        values = np.broadcast_to(values, (len(xy),)).reshape(np.shape(x))
+        if not np.all(np.isfinite(values)) or np.any(values < 0.0):
+            raise InvalidArgumentError("mu(x, y) must be finite and >= 0 over the whole patch")
+        return values
+
+    if isinstance(field, PointsField):
+        friction = local_mu(field.xy[:, 0], field.xy[:, 1])
+        return _posed(PointSetKernel(field.xy, field.weights * friction, discrete=True), pose)
+    from fixplan.function_kernel import FunctionKernel
+
+    pressure = None
+    if isinstance(field, DiskField):
+        radius = field.radius_m
+        if field.profile == "ring":
+            regions = (("circle", radius, 1.0),)
+        elif field.profile == "annulus":
+            regions = (("disk", radius, 1.0), ("disk", field.inner_radius, -1.0))
+        else:
+            regions = (("disk", radius, 1.0),)
+            profile = _PROFILE_PRESSURE[field.profile]
+            if profile is not None:
+                pressure = lambda x, y: profile((x * x + y * y) / radius**2)  # noqa: E731
+    elif isinstance(field, PolygonField):
+        regions = _regions(field)
+    elif isinstance(field, GridField):
+        centers, fractions = field.cells()
+        dx, dy = field.cell_size
+        corners = np.array([[-dx, -dy], [dx, -dy], [dx, dy], [-dx, dy]]) / 2.0
+        regions = tuple(
+            ("polygon", c + corners, f) for c, f in zip(centers, fractions, strict=True)
+        )
+    elif isinstance(field, FunctionField):
+        regions, pressure = _regions(field.shape), field.function
+    else:  # pragma: no cover
+        raise InvalidArgumentError(f"unsupported field type {type(field).__name__}")
+    return _posed(FunctionKernel(regions=regions, pressure=pressure, friction=local_mu), pose)

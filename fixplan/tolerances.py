@@ -1,0 +1,31 @@
+"""Named numerical tolerances, in one place.
+
+Each constant says what it bounds. Relative tolerances are dimensionless.
+"""
+
+#: Newton on the inverse map stops when its decrement is below ``INVERSE_RTOL**2 * h``: the
+#: twist is then accurate to about ``INVERSE_RTOL`` and the safety factor to its square.
+INVERSE_RTOL = 1e-12
+
+#: Most Newton iterations of the inverse map before it gives up (per query).
+INVERSE_MAX_ITERATIONS = 100
+
+#: A load whose safety factor is at least ``1 - CONTAINMENT_RTOL`` counts as held.
+CONTAINMENT_RTOL = 1e-9
+
+#: Relative tolerance of the facet test of point supports: a load is taken to lie on the facet of
+#: a support point when the force that point must carry exceeds its friction limit by less than
+#: this fraction.
+FACET_RTOL = 1e-12
+
+#: Relative step of the central differences that give Hessians of closed-form support functions
+#: (the Hessian only steers Newton's method; the answer is fixed by the exact gradient).
+HESSIAN_STEP = 1e-6
+
+#: A centre of rotation farther than this many patch radii from the patch is "far": the exact
+#: closed forms lose digits to cancellation there, so Gauss quadrature of the (then analytic)
+#: integrand is used instead.
+FAR_FIELD_RADII = 4.0
+
+#: Points of a pressure field closer than this fraction of the field's size are one point.
+COINCIDENT_POINTS_RTOL = 1e-12

@@ -1,0 +1,97 @@
+"""Argument checks shared by the public constructors.
+
+Each check raises :class:`~fixplan.errors.InvalidArgumentError` whose message names the argument,
+the value received and the range allowed.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from fixplan.errors import InvalidArgumentError
+
+
+def finite_scalar(name: str, value: object) -> float:
+    """Return ``value`` as a finite float."""
+    try:
+        number = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError) as exc:
+        raise InvalidArgumentError(f"{name} must be a real number, got {value!r}") from exc
+    if not math.isfinite(number):
+        raise InvalidArgumentError(f"{name} must be finite, got {number!r}")
+    return number
+
+
+def positive_scalar(name: str, value: object) -> float:
+    """Return ``value`` as a finite float > 0."""
+    number = finite_scalar(name, value)
+    if number <= 0.0:
+        raise InvalidArgumentError(f"{name} must be > 0, got {number!r}")
+    return number
+
+
+def nonnegative_scalar(name: str, value: object) -> float:
+    """Return ``value`` as a finite float >= 0."""
+    number = finite_scalar(name, value)
+    if number < 0.0:
+        raise InvalidArgumentError(f"{name} must be >= 0, got {number!r}")
+    return number
+
+
+def finite_array(name: str, value: object, *, shape: tuple[int | None, ...]) -> np.ndarray:
+    """Return ``value`` as a read-only float array of ``shape`` (``None`` = any length)."""
+    try:
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidArgumentError(
+            f"{name} must be an array of real numbers, got {value!r}"
+        ) from exc
+    expected = "(" + ", ".join("n" if n is None else str(n) for n in shape) + ")"
+    if array.ndim != len(shape) or any(
+        n is not None and size != n for size, n in zip(array.shape, shape, strict=True)
+    ):
+        raise InvalidArgumentError(f"{name} must have shape {expected}, got {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise InvalidArgumentError(f"{name} must be finite, got a NaN or infinite entry")
+    array.setflags(write=False)
+    return array
+
+
+def vector_batch(name: str, value: object, *, width: int) -> tuple[np.ndarray, bool]:
+    """Return ``value`` as a ``(K, width)`` float array and whether it was a single vector."""
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidArgumentError(
+            f"{name} must be an array of real numbers, got {value!r}"
+        ) from exc
+    single = array.ndim == 1
+    if single:
+        array = array[np.newaxis, :]
+    if array.ndim != 2 or array.shape[1] != width:
+        raise InvalidArgumentError(
+            f"{name} must have shape ({width},) or (K, {width}), got {np.shape(value)}"
+        )
+    if not np.all(np.isfinite(array)):
+        bad = int(np.flatnonzero(~np.all(np.isfinite(array), axis=1))[0])
+        raise InvalidArgumentError(f"{name}[{bad}] is not finite: {array[bad].tolist()}")
+    return array, single
+
+
+def choice(name: str, value: object, allowed: tuple[str, ...]) -> str:
+    """Return ``value`` if it is one of ``allowed``."""
+    if value not in allowed:
+        raise InvalidArgumentError(
+            f"{name} must be one of {', '.join(repr(a) for a in allowed)}; got {value!r}"
+        )
+    return str(value)
+
+
+def callable_argument(name: str, value: object) -> Callable:
+    """Return ``value`` if it is callable."""
+    if not callable(value):
+        raise InvalidArgumentError(f"{name} must be a function of (x, y), got {value!r}")
+    return value
