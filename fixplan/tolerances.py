@@ -29,3 +29,12 @@ FAR_FIELD_RADII = 4.0
 
 #: Points of a pressure field closer than this fraction of the field's size are one point.
 COINCIDENT_POINTS_RTOL = 1e-12
+
+#: The planner's equilibrium residual must be below this fraction of the largest wrench term.
+EQUILIBRIUM_RTOL = 1e-6
+
+#: A contact wrench may exceed its friction set by this fraction before verification fails.
+FRICTION_SET_RTOL = 1e-6
+
+#: Fixed-force objectives cap each load scale here; reaching the cap means "any multiple".
+MAX_SAFETY_FACTOR = 1e6

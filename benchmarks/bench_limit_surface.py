@@ -1,0 +1,151 @@
+"""Speed and accuracy of the exact limit surface, each figure next to a baseline run here.
+
+Run: ``python benchmarks/bench_limit_surface.py`` (add ``--quick`` for a smaller run). Prints
+medians of repeated runs; the machines are shared and noisy, so compare ratios.
+"""
+
+from __future__ import annotations
+
+import argparse
+import resource
+import time
+
+import numpy as np
+
+from fixplan import LimitSurface, pressure
+
+
+def median_time(function, repeats: int) -> float:
+    """Median wall time [s] of ``repeats`` calls."""
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        function()
+        times.append(time.perf_counter() - start)
+    return float(np.median(times))
+
+
+def numpy_forward(points, weights, twists, chunk=64):
+    """Baseline: the forward map as a plain NumPy broadcast, chunked to bound memory."""
+    loads = np.empty((len(twists), 3))
+    x, y = points[:, 0], points[:, 1]
+    for start in range(0, len(twists), chunk):
+        v = twists[start : start + chunk]
+        ux = v[:, 0, None] - v[:, 2, None] * y[None, :]
+        uy = v[:, 1, None] + v[:, 2, None] * x[None, :]
+        speed = np.hypot(ux, uy)
+        gx, gy = weights * ux / speed, weights * uy / speed
+        loads[start : start + chunk] = np.column_stack(
+            [gx.sum(1), gy.sum(1), (x * gy - y * gx).sum(1)]
+        )
+    return loads
+
+
+def bench_forward(n_points: int, n_twists: int, repeats: int) -> None:
+    rng = np.random.default_rng(0)
+    xy = rng.uniform(-0.05, 0.05, size=(n_points, 2))
+    surface = LimitSurface(pressure.points(xy), mu=0.5, normal_force=100.0)
+    twists = rng.normal(size=(n_twists, 3)) * np.array([1.0, 1.0, 20.0])
+    rss_before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    surface.load(twists[:8])  # compile
+    fast = median_time(lambda: surface.load(twists), repeats)
+    rss_after = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    points, weights = surface.field.quadrature()
+    weights = weights * 0.5 * 100.0
+    base_twists = twists[: max(1, n_twists // 10)]
+    base = median_time(lambda: numpy_forward(points, weights, base_twists), 1) * 10
+    check = numpy_forward(points, weights, twists[:50])
+    error = np.max(np.abs(surface.load(twists[:50]) - check)) / np.max(np.abs(check))
+    pairs = n_points * n_twists
+    print(f"forward map, {n_points} points x {n_twists} twists")
+    print(f"  fixplan (numba, parallel)  {pairs / fast / 1e6:9.1f} M evaluations/s  ({fast:.3f} s)")
+    print(f"  NumPy broadcast baseline   {pairs / base / 1e6:9.1f} M evaluations/s")
+    print(f"  speed-up                   {base / fast:9.1f} x")
+    print(f"  agreement                  {error:9.1e} (max relative difference)")
+    print(f"  peak resident memory       {rss_after / 1024:9.0f} MB (whole process, incl. numba)")
+    del rss_before
+
+
+def socp_safety(points, friction, load):
+    """Baseline: safety factor and sliding twist of one load as a cvxpy + Clarabel SOCP."""
+    import cvxpy as cp
+
+    forces = cp.Variable((len(points), 2))
+    scale = cp.Variable()
+    moment = cp.sum(cp.multiply(points[:, 0], forces[:, 1]) - cp.multiply(points[:, 1], forces[:, 0]))
+    balance = [cp.sum(forces[:, 0]) == scale * load[0], cp.sum(forces[:, 1]) == scale * load[1]]
+    balance.append(moment == scale * load[2])
+    cones = [cp.norm(forces, 2, axis=1) <= friction]
+    problem = cp.Problem(cp.Maximize(scale), balance + cones)
+    problem.solve(
+        solver=cp.CLARABEL, tol_gap_abs=1e-11, tol_gap_rel=1e-11, tol_feas=1e-11, tol_ktratio=1e-9
+    )
+    twist = -np.array([c.dual_value for c in balance], dtype=float).ravel()
+    return scale.value, twist
+
+
+def bench_inverse(n_points: int, n_queries: int, n_socp: int, repeats: int) -> None:
+    rng = np.random.default_rng(1)
+    xy = rng.uniform(-0.05, 0.05, size=(n_points, 2))
+    surface = LimitSurface(pressure.points(xy), mu=0.5, normal_force=100.0)
+    twists = rng.normal(size=(n_queries, 3)) * np.array([1.0, 1.0, 20.0])
+    loads = surface.load(twists) * rng.uniform(0.3, 2.0, size=(n_queries, 1))
+    surface.motion_and_safety_factor(loads[:4])  # compile
+    fast = median_time(lambda: surface.motion_and_safety_factor(loads), repeats)
+    motions, safety = surface.motion_and_safety_factor(loads[:n_socp])
+    points, weights = surface.field.quadrature()
+    friction = weights * 0.5 * 100.0
+    start = time.perf_counter()
+    results = [socp_safety(points, friction, load) for load in loads[:n_socp]]
+    socp = (time.perf_counter() - start) / n_socp
+    safety_gap = max(abs(s - r[0]) / r[0] for s, r in zip(safety, results, strict=True))
+    rho = surface.characteristic_length
+    angles = []
+    for motion, (_, twist) in zip(motions, results, strict=True):
+        a, b = motion * [1, 1, rho], twist * [1, 1, rho]
+        angles.append(np.arctan2(np.linalg.norm(np.cross(a, b)), a @ b))
+    print(f"inverse map (safety factor + motion), {n_points}-point field")
+    print(f"  fixplan (Newton, batched)  {n_queries / fast:9.0f} queries/s  ({fast:.3f} s)")
+    print(f"  cvxpy + Clarabel SOCP      {1.0 / socp:9.1f} queries/s  ({n_socp} queries)")
+    print(f"  speed-up                   {socp * n_queries / fast:9.0f} x")
+    print(f"  safety factor agreement    {safety_gap:9.1e} (max relative difference)")
+    print(f"  motion agreement           {max(angles):9.1e} rad (max angle)")
+
+
+def bench_accuracy() -> None:
+    """Error of point-quadrature surfaces against the closed forms, versus point count."""
+    rng = np.random.default_rng(2)
+    fields = {
+        "uniform disk": pressure.disk(0.01),
+        "Hertz disk": pressure.disk(0.01, "hertz"),
+        "10:1 rectangle": pressure.rectangle(0.1, 0.01),
+    }
+    print("accuracy vs cost: max relative load error of a quadrature of n points")
+    print(f"  {'field':16s} {'order':>5s} {'points':>8s} {'error':>9s}")
+    for name, field in fields.items():
+        exact = LimitSurface(field, mu=1.0)
+        cors = rng.uniform(-2.0, 2.0, size=(400, 2)) * field.radius
+        reference = exact.load_at_cor(cors)
+        for order in (4, 8, 16, 32, 64):
+            xy, w = field.quadrature(order)
+            approx = LimitSurface(pressure.points(xy, w, centered=False), mu=1.0)
+            error = np.linalg.norm(approx.load_at_cor(cors) - reference, axis=1)
+            error = np.max(error / np.linalg.norm(reference, axis=1))
+            print(f"  {name:16s} {order:5d} {len(xy):8d} {error:9.1e}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--quick", action="store_true", help="smaller sizes (for CI)")
+    args = parser.parse_args()
+    if args.quick:
+        bench_forward(2000, 2000, 3)
+        bench_inverse(4096, 500, 3, 3)
+    else:
+        bench_forward(10_000, 10_000, 5)
+        bench_inverse(4096, 4000, 20, 5)
+    bench_accuracy()
+
+
+if __name__ == "__main__":
+    main()

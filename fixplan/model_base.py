@@ -1,0 +1,302 @@
+r"""The interface shared by every friction model of :mod:`fixplan.models`.
+
+A friction model is a convex, centrally symmetric set of loads ``(fx, fy, m)`` (area contacts)
+or forces ``(fx, fy)`` (point contacts) that scales linearly with the normal force ``N`` of its
+contact. Every model stores its geometry per unit normal force and works in the normalised
+coordinates of the paper (Table 2, step 3),
+
+.. math:: q = \left(\frac{f_x}{\mu N}, \frac{f_y}{\mu N}, \frac{m}{\mu \rho N}\right),
+
+where ``mu`` is the model's friction coefficient (maximum force per unit normal force) and
+``rho`` [m] its characteristic length (maximum moment over maximum force, the paper's
+``lambda``). There the set is ``{q : g(q) <= 1}`` for a gauge ``g`` (a positively homogeneous
+convex function), so that
+
+- the safety factor of a load is ``1 / g(q)``;
+- the model holds the load when the safety factor is at least ``1 - CONTAINMENT_RTOL``;
+- the sliding motion, for models that have one, is the outward normal ``∇g(q)`` of the set at
+  the load scaled onto its boundary (normality); returned as a twist ``(vx, vy, w)`` scaled so
+  that ``(vx, vy, rho * w)`` has unit norm, like :meth:`fixplan.LimitSurface.motion`;
+- as cvxpy constraints the set is ``g(q) <= N`` with ``q = (fx/mu, fy/mu, m/(mu rho))``, which
+  is homogeneous in ``N``: ``N`` may be a float, a Parameter or an affine expression of
+  variables (the normal force of a contact that the planner chooses).
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from typing import TYPE_CHECKING, ClassVar
+
+import numpy as np
+
+from fixplan import validation
+from fixplan.errors import InvalidArgumentError, ModelError
+from fixplan.sphere import circle
+from fixplan.tolerances import CONTAINMENT_RTOL
+
+if TYPE_CHECKING:  # pragma: no cover - typing only; cvxpy is imported when constraints are built
+    import cvxpy as cp
+
+_PLANES = {"fx-m": (0, 2), "fy-m": (1, 2), "fx-fy": (0, 1)}
+
+
+class FrictionModel(ABC):
+    """A friction model: a convex set of loads, scaled by the normal force of its contact.
+
+    Subclasses are frozen dataclasses with the attributes ``mu`` [-], ``normal_force`` [N]
+    (the default of the numeric methods) and, for area models, ``rho`` [m].
+    """
+
+    __slots__ = ()
+
+    #: Whether the model's set lies inside the exact limit surface for every load (it never
+    #: claims a load is held that the exact surface would let slide).
+    conservative: ClassVar[bool]
+
+    #: Whether the contact bears a torsional moment (area models) or only force (point models).
+    torsion: ClassVar[bool] = True
+
+    mu: float
+    normal_force: float
+
+    # -- geometry hooks (normalised coordinates q, see the module docstring) ------------------
+
+    @abstractmethod
+    def _gauge(self, q: np.ndarray) -> np.ndarray:
+        """Gauge ``g(q)`` ``(K,)`` of normalised loads ``q`` ``(K, d)``; 0 at 0."""
+
+    def _normal(self, q: np.ndarray) -> np.ndarray:
+        """Outward normals ``(K, d)`` (any length) of the set at the rays through ``q``."""
+        raise ModelError(
+            f"{type(self).__name__} has no motion map: the normals of its surface do not give "
+            "the sliding direction (paper §4.2); use Ellipsoid, FittedEllipsoid, "
+            "FacetedEllipsoid or Exact to predict motion"
+        )
+
+    @abstractmethod
+    def _unit_constraints(self, q: cp.Expression, normal_force: cp.Expression) -> list:
+        """cvxpy constraints for ``g(q) <= normal_force``, convex and DPP."""
+
+    # -- description -------------------------------------------------------------------------
+
+    @property
+    def rho(self) -> float:
+        """Characteristic length [m]: maximum moment over maximum force (0 for point models)."""
+        return 0.0
+
+    @property
+    def has_motion(self) -> bool:
+        """Whether :meth:`motion` is defined (the normals of the set give the sliding twist)."""
+        return type(self)._normal is not FrictionModel._normal
+
+    @property
+    def load_dimension(self) -> int:
+        """Length of the load vector of :meth:`constraints`: 3 ``(ft1, ft2, mn)`` or 2."""
+        return 3 if self.torsion else 2
+
+    @property
+    def max_force(self) -> float:
+        """Largest friction force [N] at the model's ``normal_force``."""
+        return self.mu * self.normal_force
+
+    @property
+    def max_moment(self) -> float:
+        """Largest friction moment [N m] at the model's ``normal_force`` (0: point models)."""
+        return self.mu * self.rho * self.normal_force
+
+    def _units(self) -> np.ndarray:
+        """Normalisation per unit normal force: ``(mu, mu, mu rho)`` or ``(mu, mu)``."""
+        if self.torsion:
+            return np.array([self.mu, self.mu, self.mu * self.rho])
+        return np.array([self.mu, self.mu])
+
+    # -- numeric queries ---------------------------------------------------------------------
+
+    def _normalised(self, load, normal_force) -> tuple[np.ndarray, bool, np.ndarray]:
+        """Normalised loads ``q``, whether one load was given, and which loads twist a point."""
+        force = (
+            self.normal_force
+            if normal_force is None
+            else validation.positive_scalar("normal_force", normal_force)
+        )
+        if self.torsion:
+            loads, single = validation.vector_batch("load", load, width=3)
+            twisted = np.zeros(len(loads), dtype=bool)
+        else:
+            loads, single = _point_loads(load)
+            twisted = loads[:, 2] != 0.0
+            loads = loads[:, :2]
+        return loads / (force * self._units()), single, twisted
+
+    def safety_factor(self, load, *, normal_force: float | None = None) -> np.ndarray | float:
+        """Factor ``s`` with ``s * load`` on the boundary of the model's set.
+
+        Parameters
+        ----------
+        load : array_like
+            ``(fx, fy, m)`` [N, N, N m], ``(3,)`` or ``(K, 3)``; point models also take
+            ``(fx, fy)`` and give 0 for loads with a moment (a point bears no torsion).
+        normal_force : float, optional
+            Normal force of the contact [N]; default the model's ``normal_force``.
+
+        Returns
+        -------
+        float or numpy.ndarray
+            ``inf`` for the zero load; ``s > 1``: held with that margin; ``s < 1``: slides.
+        """
+        q, single, twisted = self._normalised(load, normal_force)
+        gauge = self._gauge(q)
+        with np.errstate(divide="ignore"):
+            safety = np.where(gauge > 0.0, 1.0 / np.where(gauge > 0.0, gauge, 1.0), np.inf)
+        safety[twisted] = 0.0
+        return float(safety[0]) if single else safety
+
+    def contains(self, load, *, normal_force: float | None = None) -> np.ndarray | bool:
+        """Whether the model holds ``load`` (safety factor >= ``1 - CONTAINMENT_RTOL``)."""
+        safety = self.safety_factor(load, normal_force=normal_force)
+        held = np.asarray(safety) >= 1.0 - CONTAINMENT_RTOL
+        return bool(held) if held.ndim == 0 else held
+
+    def motion(self, load, *, normal_force: float | None = None) -> np.ndarray:
+        """Unit twist of impending sliding under ``load``, by normality on the model's surface.
+
+        The load is scaled onto the surface first (its magnitude does not matter). The twist
+        ``(vx, vy, w)`` is scaled so that ``(vx, vy, rho * w)`` has unit norm; point models
+        return the unit sliding velocity ``(vx, vy)`` (``(vx, vy, 0)`` for 3-vector loads).
+        NaN for the zero load and for a point model loaded by a moment.
+
+        Raises
+        ------
+        ModelError
+            For models whose normals do not give the sliding direction (cone, pyramids).
+        """
+        q, single, twisted = self._normalised(load, normal_force)
+        width = q.shape[1]
+        normals = np.full((len(q), width), np.nan)
+        moving = np.flatnonzero(np.any(q != 0.0, axis=1) & ~twisted)
+        if moving.size:
+            normals[moving] = self._normal(q[moving])
+        normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+        if self.torsion:
+            twists = normals / np.array([1.0, 1.0, self.rho])
+        else:
+            twists = normals
+            if np.ndim(load) and np.shape(load)[-1] == 3:
+                twists = np.column_stack([normals, np.where(np.isnan(normals[:, 0]), np.nan, 0.0)])
+        return twists[0] if single else twists
+
+    def curve(
+        self,
+        plane: str = "fy-m",
+        n: int = 361,
+        *,
+        normalized: bool = False,
+        normal_force: float | None = None,
+    ) -> np.ndarray:
+        """Cross section of the model's set by a coordinate plane, as loads ``(n, 3)``.
+
+        Same conventions as :meth:`fixplan.LimitSurface.curve`: ``plane`` is ``"fx-m"``,
+        ``"fy-m"`` or ``"fx-fy"`` (point models: ``"fx-fy"`` only); points evenly spread in
+        angle in normalised coordinates. With ``normalized`` forces are divided by
+        ``max_force`` and moments by ``max_moment`` (both at ``normal_force``).
+        """
+        axes = _PLANES.get(plane)
+        if axes is None:
+            raise InvalidArgumentError(f"plane must be one of {', '.join(_PLANES)}; got {plane!r}")
+        if not self.torsion and plane != "fx-fy":
+            raise InvalidArgumentError(
+                f"a point model bears no moment: its only section is 'fx-fy', got {plane!r}"
+            )
+        if not isinstance(n, int | np.integer) or n < 1:
+            raise InvalidArgumentError(f"n must be a positive integer, got {n!r}")
+        force = self.normal_force if normal_force is None else normal_force
+        force = validation.positive_scalar("normal_force", force)
+        units = np.array([self.mu, self.mu, self.mu * self.rho]) * force
+        directions = np.zeros((int(n), 3))
+        directions[:, axes] = circle(int(n))
+        safety = self.safety_factor(directions * units, normal_force=force)
+        loads = directions * units * safety[:, None]
+        if normalized:
+            return loads / np.where(units > 0.0, units, 1.0)
+        return loads
+
+    # -- convex constraints ------------------------------------------------------------------
+
+    def constraints(self, load, normal_force) -> list:
+        """cvxpy constraints stating that ``load`` lies in the set at ``normal_force``.
+
+        Parameters
+        ----------
+        load : cvxpy expression or array_like
+            Area models: shape ``(3,)``, ``(ft1, ft2, mn)`` [N, N, N m] in the patch frame.
+            Point models: shape ``(2,)`` ``(ft1, ft2)``, or ``(3,)`` whose moment is then
+            constrained to 0.
+        normal_force : cvxpy expression, Parameter or float
+            Scalar normal force of the contact [N]. The constraints are homogeneous in it, so
+            it may itself be a decision variable.
+
+        Returns
+        -------
+        list of cvxpy.Constraint
+            Convex and DPP (``problem.is_dcp(dpp=True)`` holds with Parameters).
+        """
+        import cvxpy as cp
+
+        load = load if isinstance(load, cp.Expression) else cp.Constant(np.asarray(load, float))
+        if not isinstance(normal_force, cp.Expression):
+            normal_force = cp.Constant(validation.nonnegative_scalar("normal_force", normal_force))
+        if normal_force.shape not in ((), (1,)):
+            raise InvalidArgumentError(
+                f"normal_force must be a scalar expression, got shape {normal_force.shape}"
+            )
+        if normal_force.shape == (1,):
+            normal_force = cp.reshape(normal_force, (), order="C")
+        allowed = ((3,),) if self.torsion else ((2,), (3,))
+        if load.shape not in allowed:
+            raise InvalidArgumentError(
+                f"load must have shape {' or '.join(str(s) for s in allowed)} for "
+                f"{type(self).__name__}, got {load.shape}"
+            )
+        extra = []
+        if not self.torsion and load.shape == (3,):
+            extra.append(load[2] == 0.0)
+            load = load[:2]
+        q = cp.multiply(1.0 / self._units(), load)
+        return self._unit_constraints(q, normal_force) + extra
+
+
+def _point_loads(load) -> tuple[np.ndarray, bool]:
+    """Loads of a point model as ``(K, 3)`` (zero moment appended to 2-vectors)."""
+    shape = np.shape(load)
+    width = shape[-1] if shape else 0
+    if width not in (2, 3):
+        raise InvalidArgumentError(
+            f"load of a point model must have shape (2,), (3,), (K, 2) or (K, 3), got {shape}"
+        )
+    loads, single = validation.vector_batch("load", load, width=width)
+    if width == 2:
+        loads = np.column_stack([loads, np.zeros(len(loads))])
+    return loads, single
+
+
+def finite_pair(name: str, value) -> tuple[float, float]:
+    """``value`` as a tuple of two finite floats."""
+    pair = validation.finite_array(name, value, shape=(2,))
+    return float(pair[0]), float(pair[1])
+
+
+def facet_count(value) -> int:
+    """Number of facets of a pyramid, an integer >= 3."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 3:
+        raise InvalidArgumentError(f"facets must be an integer >= 3, got {value!r}")
+    return int(value)
+
+
+def polygon_normals(facets: int) -> np.ndarray:
+    """Outward unit normals ``(k, 2)`` of a regular ``k``-gon, the first along +x."""
+    return circle(facets)
+
+
+def fmt(value: float) -> str:
+    """A number for a repr: 6 significant digits."""
+    return f"{value:.6g}"

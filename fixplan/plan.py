@@ -1,0 +1,143 @@
+"""What the planner reports: a verified :class:`Plan`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fixplan.screw import Screw
+
+STATUSES = ("optimal", "infeasible", "unbounded", "inaccurate", "solver-error")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Plan:
+    """The answer to a :class:`~fixplan.Problem`, verified in numpy before it is reported.
+
+    Attributes
+    ----------
+    status : str
+        ``"optimal"``, ``"infeasible"``, ``"unbounded"``, ``"inaccurate"`` (the solver's answer
+        failed verification or the solver said so) or ``"solver-error"``.
+    objective : str
+        The objective solved.
+    objective_value : float or None
+        Total or largest force [N] for the force objectives; the smallest safety factor over
+        the load cases for ``"max-safety-factor"`` and ``"check"``.
+    load_names, contact_names : tuple of str
+        Order of the load cases and contacts in the arrays below.
+    normal_forces : array (contacts, loads)
+        Normal force of every contact in every load case [N] (at the task loads, or at the
+        state of impending slip for the fixed-force objectives).
+    contact_wrenches : array (contacts, loads, 4)
+        ``(fn, ft1, ft2, mn)`` of every contact in its own frame [N, N m], same state.
+    forces : dict
+        Active contacts' normal forces [N]: a float for a clamp, an array over the load cases
+        for a finger.
+    safety_factors : dict
+        Per load case: the largest factor by which its task load (not gravity) can be scaled
+        while held with these active forces (``inf`` when no scale breaks the hold).
+    safety_factor : float
+        The smallest of ``safety_factors``.
+    held : dict
+        Per load case: whether the task load itself is held (safety factor >= 1).
+    utilisation : array (contacts, loads)
+        At the state of impending slip, the fraction of each contact's friction set its wrench
+        uses (1 on the limit).
+    motions : dict
+        Per load case: the :class:`~fixplan.screw.Screw` in which the body starts to slide when
+        the task load exceeds its margin (``None`` when unbounded), from the dual of the
+        equilibrium constraints.
+    critical_load, critical_contact : str or None
+        The load case with the smallest safety factor and its most used contact.
+    certificate : str or None
+        For an infeasible problem: which load case cannot be held and along which motion
+        nothing resists it.
+    infeasible_motions : dict
+        For an infeasible problem: the unresisted motion per load case that cannot be held.
+    residual : float
+        Largest relative equilibrium residual found by the verification.
+    warnings : tuple of str
+        Why the status is ``"inaccurate"``, and other caveats.
+    solver : str
+        The solver that produced the answer.
+    solve_time : float
+        Wall time of the solve(s) [s].
+    """
+
+    status: str
+    objective: str
+    objective_value: float | None
+    load_names: tuple[str, ...]
+    contact_names: tuple[str, ...]
+    normal_forces: np.ndarray | None = None
+    contact_wrenches: np.ndarray | None = None
+    forces: dict = field(default_factory=dict)
+    safety_factors: dict = field(default_factory=dict)
+    safety_factor: float | None = None
+    held: dict = field(default_factory=dict)
+    utilisation: np.ndarray | None = None
+    motions: dict = field(default_factory=dict)
+    critical_load: str | None = None
+    critical_contact: str | None = None
+    certificate: str | None = None
+    infeasible_motions: dict = field(default_factory=dict)
+    residual: float | None = None
+    warnings: tuple[str, ...] = ()
+    solver: str = ""
+    solve_time: float = 0.0
+
+    @property
+    def succeeded(self) -> bool:
+        """Whether the status is ``"optimal"``."""
+        return self.status == "optimal"
+
+    def as_dict(self) -> dict:
+        """JSON-ready description of the plan."""
+
+        def number(x):
+            x = float(x)
+            return x if np.isfinite(x) else ("inf" if x > 0 else "-inf" if x < 0 else "nan")
+
+        forces = {
+            name: (number(v) if np.ndim(v) == 0 else [number(x) for x in v])
+            for name, v in self.forces.items()
+        }
+        return {
+            "status": self.status,
+            "objective": self.objective,
+            "objective_value": None if self.objective_value is None else number(self.objective_value),
+            "forces_N": forces,
+            "safety_factors": {k: number(v) for k, v in self.safety_factors.items()},
+            "safety_factor": None if self.safety_factor is None else number(self.safety_factor),
+            "held": dict(self.held),
+            "critical_load": self.critical_load,
+            "critical_contact": self.critical_contact,
+            "motions": {k: (None if m is None else m.as_dict()) for k, m in self.motions.items()},
+            "certificate": self.certificate,
+            "infeasible_motions": {k: m.as_dict() for k, m in self.infeasible_motions.items()},
+            "contact_wrenches": None
+            if self.contact_wrenches is None
+            else {
+                contact: {
+                    load: [number(x) for x in self.contact_wrenches[i, j]]
+                    for j, load in enumerate(self.load_names)
+                }
+                for i, contact in enumerate(self.contact_names)
+            },
+            "utilisation": None
+            if self.utilisation is None
+            else {
+                contact: {
+                    load: number(self.utilisation[i, j]) for j, load in enumerate(self.load_names)
+                }
+                for i, contact in enumerate(self.contact_names)
+            },
+            "residual": self.residual,
+            "warnings": list(self.warnings),
+            "solver": self.solver,
+        }
+
+
+__all__ = ["STATUSES", "Plan", "Screw"]

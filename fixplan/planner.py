@@ -1,0 +1,433 @@
+r"""The convex fixture and grasp planner.
+
+Every load case ``j`` must be in equilibrium,
+
+.. math:: \sum_i G_i \, (f_{n,ij}, \ell_{ij}) + s_j W_j + W_g = 0,
+   \qquad \ell_{ij} \in f_{n,ij} \, \mathcal F_i, \qquad f_{n,ij} \ge 0,
+
+with ``G_i`` the map from contact ``i``'s normal force and friction load ``ℓ`` (``ft1, ft2[, mn]``)
+to the body wrench about the world origin, ``F_i`` its friction model at unit normal force,
+``W_j`` the task wrench and ``W_g`` gravity. Force objectives fix ``s_j = 1`` and minimise
+normal forces; the fixed-force objectives maximise each ``s_j``. The cvxpy problem is built once
+per structure with Parameters for the task wrenches, gravity and the fixed forces (it is DPP), so
+new load values re-solve without rebuilding. The dual of the equilibrium constraint of a case is
+the twist in which the body starts to slide (maximum power); for an infeasible problem it is the
+motion that nothing resists.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import cvxpy as cp
+import numpy as np
+
+from fixplan.contact_models import contact_model
+from fixplan.errors import FixplanError, InvalidArgumentError
+from fixplan.plan import Plan
+from fixplan.problem import FIXED_FORCE_OBJECTIVES, PASSIVE_ROLES, Load, Problem
+from fixplan.screw import Screw
+from fixplan.tolerances import (
+    EQUILIBRIUM_RTOL,
+    FRICTION_SET_RTOL,
+    MAX_SAFETY_FACTOR,
+)
+
+SOLVERS = ("CLARABEL", "OSQP", "SCS")
+_FALLBACK = {"CLARABEL": "SCS", "SCS": "CLARABEL", "OSQP": "CLARABEL"}
+_SOLVER_OPTIONS = {
+    "CLARABEL": {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9},
+    "SCS": {"eps": 1e-9, "max_iters": 200_000},
+    "OSQP": {"eps_abs": 1e-9, "eps_rel": 1e-9, "max_iter": 200_000, "polish": True},
+}
+_STATUS = {
+    cp.OPTIMAL: "optimal",
+    cp.OPTIMAL_INACCURATE: "inaccurate",
+    cp.INFEASIBLE: "infeasible",
+    cp.INFEASIBLE_INACCURATE: "infeasible",
+    cp.UNBOUNDED: "unbounded",
+    cp.UNBOUNDED_INACCURATE: "unbounded",
+}
+
+
+class SolverFailure(FixplanError, RuntimeError):
+    """The solver and its fallback both failed."""
+
+
+@dataclass(frozen=True, slots=True)
+class _Built:
+    """A compiled cvxpy problem and its handles."""
+
+    problem: cp.Problem
+    task: cp.Parameter
+    gravity: cp.Parameter
+    fixed: dict  # contact index -> Parameter of its fixed force
+    normal: cp.Expression  # (contacts, loads)
+    friction: cp.Variable  # (friction dims, loads)
+    scale: cp.Expression  # (loads,) task-load scale factors
+    balance: cp.Constraint
+
+
+class Planner:
+    """A problem's structure compiled to cvxpy, re-solvable with new load values.
+
+    Parameters
+    ----------
+    problem : Problem
+        The problem; its loads are the default load values.
+    solver : str, optional
+        ``"CLARABEL"`` (default), ``"OSQP"`` (LP/QP only: pyramid models) or ``"SCS"``.
+    """
+
+    def __init__(self, problem: Problem, *, solver: str | None = None):
+        if not isinstance(problem, Problem):
+            raise InvalidArgumentError(f"problem must be a Problem, got {type(problem).__name__}")
+        solver = "CLARABEL" if solver is None else str(solver).upper()
+        if solver not in SOLVERS:
+            raise InvalidArgumentError(f"solver must be one of {', '.join(SOLVERS)}; got {solver!r}")
+        self.problem = problem
+        self.solver = solver
+        self.models = [contact_model(c) for c in problem.contacts]
+        dims = [model.load_dimension for model in self.models]
+        self._slices = []
+        start = 0
+        for d in dims:
+            self._slices.append(slice(start, start + d))
+            start += d
+        self._normal_map = np.column_stack([c.wrench_basis()[:, 0] for c in problem.contacts])
+        self._friction_map = np.hstack(
+            [c.wrench_basis()[:, 1 : 1 + d] for c, d in zip(problem.contacts, dims, strict=True)]
+        )
+        positions = np.array([c.position for c in problem.contacts])
+        spread = np.linalg.norm(positions - problem.body.center_of_mass, axis=1)
+        self.length_scale = float(max(spread.max(), 1e-3))
+        self._built: dict[str, _Built] = {}
+
+    # -- building -----------------------------------------------------------------------------
+
+    def _build(self, objective: str) -> _Built:
+        if objective in self._built:
+            return self._built[objective]
+        contacts = self.problem.contacts
+        cases = len(self.problem.loads)
+        scaling = objective in FIXED_FORCE_OBJECTIVES
+        task = cp.Parameter((6, cases), name="task_wrenches")
+        gravity = cp.Parameter(6, name="gravity_wrench")
+        friction = cp.Variable((self._friction_map.shape[1], cases), name="friction")
+        rows, fixed, constraints = [], {}, []
+        free_clamps, free_fingers = [], []
+        ones = np.ones(cases)
+        for i, contact in enumerate(contacts):
+            if contact.role in PASSIVE_ROLES:
+                row = cp.Variable(cases, nonneg=True, name=f"fn_{i}")
+            elif scaling or contact.force is not None:
+                shape = () if contact.role == "clamp" else (cases,)
+                fixed[i] = cp.Parameter(shape, nonneg=True, name=f"force_{i}")
+                row = fixed[i] * ones if contact.role == "clamp" else fixed[i]
+            else:
+                if contact.role == "clamp":
+                    variable = cp.Variable(nonneg=True, name=f"clamp_{i}")
+                    free_clamps.append(variable)
+                    row = variable * ones
+                else:
+                    variable = cp.Variable(cases, nonneg=True, name=f"finger_{i}")
+                    free_fingers.append(variable)
+                    row = variable
+                if contact.max_force is not None:
+                    constraints.append(variable <= contact.max_force)
+            rows.append(cp.reshape(row, (1, cases), order="C"))
+        normal = cp.vstack(rows)
+        if scaling:
+            scale = cp.Variable(cases, name="scale")
+            constraints += [scale >= 0.0, scale <= MAX_SAFETY_FACTOR]
+            task_term = task @ cp.diag(scale)
+        else:
+            scale = cp.Constant(ones)
+            task_term = task
+        gravity_term = cp.reshape(gravity, (6, 1), order="C") @ np.ones((1, cases))
+        balance = self._normal_map @ normal + self._friction_map @ friction + task_term + gravity_term
+        balance_constraint = balance == 0
+        constraints.append(balance_constraint)
+        for i, model in enumerate(self.models):
+            for j in range(cases):
+                constraints += model.constraints(friction[self._slices[i], j], normal[i, j])
+        problem = cp.Problem(
+            self._objective(objective, scale, normal, free_clamps, free_fingers), constraints
+        )
+        if not problem.is_dcp(dpp=True):  # pragma: no cover - a model broke its contract
+            raise FixplanError("internal error: the planning problem is not DPP")
+        built = _Built(problem, task, gravity, fixed, normal, friction, scale, balance_constraint)
+        self._built[objective] = built
+        return built
+
+    def _objective(self, objective, scale, normal, free_clamps, free_fingers):
+        active = [i for i, c in enumerate(self.problem.contacts) if c.is_active]
+        if objective in FIXED_FORCE_OBJECTIVES:
+            return cp.Maximize(cp.sum(scale))
+        if objective == "min-total-clamp-force":
+            total = cp.sum(cp.hstack(free_clamps)) if free_clamps else 0.0
+            if free_fingers:
+                total = total + cp.max(cp.sum(cp.vstack(free_fingers), axis=0))
+            return cp.Minimize(total)
+        active_forces = normal[active, :]
+        if objective == "min-max-normal-force":
+            return cp.Minimize(cp.max(active_forces))
+        if objective == "min-total-normal-force":
+            return cp.Minimize(cp.max(cp.sum(active_forces, axis=0)))
+        return cp.Minimize(cp.sum_squares(active_forces))  # min-squared-normal-force
+
+    # -- solving ------------------------------------------------------------------------------
+
+    def solve(self, loads: Sequence[Load] | None = None, *, analyse: bool = True) -> Plan:
+        """Solve with ``loads`` (default: the problem's); the structure is reused.
+
+        ``loads`` must have the problem's number of load cases. With ``analyse`` (default) a
+        force objective is followed by the fixed-force analysis of the forces found (safety
+        factors, impending motions, utilisation).
+        """
+        loads = self.problem.loads if loads is None else tuple(loads)
+        if len(loads) != len(self.problem.loads) or not all(isinstance(x, Load) for x in loads):
+            raise InvalidArgumentError(
+                f"loads must be {len(self.problem.loads)} Load objects, one per load case"
+            )
+        objective = self.problem.objective
+        wrenches = np.column_stack([load.wrench for load in loads])
+        start = time.perf_counter()
+        fixed_values = {
+            i: c.force for i, c in enumerate(self.problem.contacts) if c.force is not None
+        }
+        result = self._run(objective, wrenches, fixed_values)
+        plan_kwargs = {"load_names": tuple(x.name for x in loads)}
+        status, solver = result["status"], result["solver"]
+        notes = list(result["warnings"])
+        if status == "infeasible":
+            motions, certificate = self._certificate(result, wrenches, plan_kwargs["load_names"])
+            return self._plan(
+                status, objective, None, plan_kwargs, solver, start, notes,
+                certificate=certificate, infeasible_motions=motions,
+            )  # fmt: skip
+        if status not in ("optimal", "inaccurate"):
+            return self._plan(status, objective, None, plan_kwargs, solver, start, notes)
+        normal, friction, scale = result["normal"], result["friction"], result["scale"]
+        residual, problems = self._verify(normal, friction, scale, wrenches)
+        if problems:
+            status = "inaccurate"
+            notes += problems
+            for note in problems:
+                warnings.warn(note, stacklevel=2)
+        forces = self._active_forces(normal)
+        analysis = result
+        if objective not in FIXED_FORCE_OBJECTIVES and analyse and status == "optimal":
+            fixed = {i: (f if np.ndim(f) == 0 else np.asarray(f)) for i, f in self._indexed(forces)}
+            analysis = self._run("check", wrenches, fixed)
+            if analysis["status"] not in ("optimal", "inaccurate"):
+                notes.append(f"safety analysis of the forces found: {analysis['status']}")
+                analysis = None
+        value = self._objective_value(objective, forces, scale)
+        extra = self._analysis(analysis, wrenches, plan_kwargs["load_names"]) if analysis else {}
+        if objective in FIXED_FORCE_OBJECTIVES and "safety_factor" in extra:
+            value = extra["safety_factor"]
+        return self._plan(
+            status, objective, value, plan_kwargs, solver, start, notes,
+            normal_forces=normal, contact_wrenches=self._wrenches(normal, friction),
+            forces=forces, residual=residual, **extra,
+        )  # fmt: skip
+
+    def _indexed(self, forces):
+        names = {c.name: i for i, c in enumerate(self.problem.contacts)}
+        return [(names[name], value) for name, value in forces.items()]
+
+    def _plan(self, status, objective, value, kwargs, solver, start, notes, **fields) -> Plan:
+        return Plan(
+            status=status,
+            objective=objective,
+            objective_value=value,
+            contact_names=tuple(c.name for c in self.problem.contacts),
+            solver=solver,
+            solve_time=time.perf_counter() - start,
+            warnings=tuple(notes),
+            **kwargs,
+            **fields,
+        )
+
+    def _run(self, objective: str, wrenches: np.ndarray, fixed_values: dict) -> dict:
+        built = self._build(objective)
+        built.task.value = wrenches
+        built.gravity.value = self.problem.body.weight_wrench
+        for i, parameter in built.fixed.items():
+            value = fixed_values[i]
+            parameter.value = value if parameter.ndim == 0 else np.broadcast_to(value, parameter.shape)
+        notes = []
+        solver = self.solver
+        status = self._call(built.problem, solver)
+        if status in ("solver-error", "inaccurate"):
+            fallback = _FALLBACK[solver]
+            notes.append(f"{solver} returned {status}; retried with {fallback}")
+            solver = fallback
+            status = self._call(built.problem, solver)
+        result = {"status": status, "solver": solver, "warnings": notes, "built": built}
+        if status in ("optimal", "inaccurate"):
+            result["normal"] = np.asarray(built.normal.value, dtype=float)
+            result["friction"] = np.asarray(built.friction.value, dtype=float)
+            result["scale"] = np.asarray(built.scale.value, dtype=float).ravel()
+        if status in ("optimal", "inaccurate", "infeasible"):
+            dual = built.balance.dual_value
+            result["dual"] = None if dual is None else np.asarray(dual, dtype=float)
+        return result
+
+    @staticmethod
+    def _call(problem: cp.Problem, solver: str) -> str:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                problem.solve(solver=solver, **_SOLVER_OPTIONS[solver])
+        except cp.error.SolverError as exc:
+            if solver == "OSQP" and "QP" in str(exc):
+                raise InvalidArgumentError(
+                    "solver OSQP handles only LP/QP problems: use pyramid models "
+                    "('pyramid', 'point-pyramid') or the default solver CLARABEL"
+                ) from exc
+            return "solver-error"
+        except cp.error.DCPError as exc:  # pragma: no cover - guarded when building
+            raise FixplanError(f"internal error: {exc}") from exc
+        return _STATUS.get(problem.status, "solver-error")
+
+    # -- verification and reporting ---------------------------------------------------------------
+
+    def _verify(self, normal, friction, scale, wrenches) -> tuple[float, list[str]]:
+        """Equilibrium residual and friction-set membership, checked in numpy."""
+        problems = []
+        gravity = self.problem.body.weight_wrench[:, None]
+        normal_part = self._normal_map @ normal
+        friction_part = self._friction_map @ friction
+        task_part = wrenches * scale[None, :]
+        residual = normal_part + friction_part + task_part + gravity
+        magnitude = np.abs(normal_part) + np.abs(friction_part) + np.abs(task_part) + np.abs(gravity)
+        relative = 0.0
+        for rows, unit in ((slice(0, 3), "N"), (slice(3, 6), "N m")):
+            size = max(float(magnitude[rows].max()), 1e-12)
+            worst = float(np.abs(residual[rows]).max())
+            relative = max(relative, worst / size)
+            if worst > EQUILIBRIUM_RTOL * size:
+                problems.append(
+                    f"equilibrium residual {worst:.3g} {unit} exceeds {EQUILIBRIUM_RTOL:g} of the "
+                    f"wrenches involved ({size:.3g} {unit})"
+                )
+        scale_force = max(float(np.abs(normal).max()), 1e-12)
+        for i, (contact, model) in enumerate(zip(self.problem.contacts, self.models, strict=True)):
+            fn = normal[i]
+            if np.any(fn < -FRICTION_SET_RTOL * scale_force):
+                problems.append(f"contact {contact.name!r} pulls: normal force {fn.min():.3g} N")
+            load = friction[self._slices[i]].T
+            pressed = fn > FRICTION_SET_RTOL * scale_force
+            loose = ~pressed & (np.abs(load).max(axis=1) > FRICTION_SET_RTOL * scale_force)
+            if np.any(loose):
+                problems.append(f"contact {contact.name!r} carries friction without normal force")
+            if np.any(pressed):
+                safety = np.atleast_1d(model.safety_factor(load[pressed] / fn[pressed, None]))
+                if np.any(safety < 1.0 - FRICTION_SET_RTOL):
+                    problems.append(
+                        f"contact {contact.name!r} exceeds its friction set by "
+                        f"{1.0 / safety.min() - 1.0:.3g}"
+                    )
+        return relative, problems
+
+    def _active_forces(self, normal) -> dict:
+        forces = {}
+        for i, contact in enumerate(self.problem.contacts):
+            if contact.role == "clamp":
+                forces[contact.name] = float(normal[i, 0])
+            elif contact.role == "finger":
+                forces[contact.name] = normal[i].copy()
+        return forces
+
+    def _objective_value(self, objective, forces, scale) -> float:
+        contacts = {c.name: c for c in self.problem.contacts}
+        if objective in FIXED_FORCE_OBJECTIVES:
+            return float(scale.min())
+        clamp = sum(v for k, v in forces.items() if contacts[k].role == "clamp")
+        fingers = [v for k, v in forces.items() if contacts[k].role == "finger"]
+        finger_total = np.sum(fingers, axis=0) if fingers else 0.0
+        if objective == "min-total-clamp-force":
+            return float(clamp + np.max(finger_total))
+        per_case = [np.broadcast_to(v, scale.shape) for v in forces.values()]
+        if objective == "min-max-normal-force":
+            return float(np.max(per_case))
+        if objective == "min-total-normal-force":
+            return float(np.max(np.sum(per_case, axis=0)))
+        return float(np.sum(np.square(per_case)))
+
+    def _wrenches(self, normal, friction) -> np.ndarray:
+        contacts, cases = normal.shape
+        out = np.zeros((contacts, cases, 4))
+        out[:, :, 0] = normal
+        for i, part in enumerate(self._slices):
+            values = friction[part].T
+            out[i, :, 1 : 1 + values.shape[1]] = values
+        return out
+
+    def _analysis(self, result, wrenches, names) -> dict:
+        """Safety factors, motions and utilisation from a fixed-force (scaling) solve."""
+        scale = result["scale"]
+        safety = np.where(scale >= MAX_SAFETY_FACTOR * (1 - 1e-6), np.inf, scale)
+        dual = result.get("dual")
+        motions = {}
+        for j, name in enumerate(names):
+            twist = None if dual is None or not np.isfinite(safety[j]) else dual[:, j]
+            if twist is None or not np.any(twist):
+                motions[name] = None
+                continue
+            twist = twist if wrenches[:, j] @ twist >= 0.0 else -twist
+            motions[name] = Screw.from_twist(twist, self.length_scale)
+        normal, friction = result["normal"], result["friction"]
+        utilisation = np.zeros(normal.shape)
+        for i, model in enumerate(self.models):
+            fn = normal[i]
+            pressed = fn > 1e-12 * max(1.0, float(np.abs(normal).max()))
+            load = friction[self._slices[i]].T
+            if np.any(pressed):
+                utilisation[i, pressed] = 1.0 / np.atleast_1d(
+                    model.safety_factor(load[pressed] / fn[pressed, None])
+                )
+        critical = int(np.argmin(safety))
+        return {
+            "safety_factors": {name: float(s) for name, s in zip(names, safety, strict=True)},
+            "safety_factor": float(safety.min()),
+            "held": {name: bool(s >= 1.0 - 1e-9) for name, s in zip(names, safety, strict=True)},
+            "motions": motions,
+            "utilisation": utilisation,
+            "critical_load": names[critical],
+            "critical_contact": self.problem.contacts[int(np.argmax(utilisation[:, critical]))].name,
+        }
+
+    def _certificate(self, result, wrenches, names) -> tuple[dict, str]:
+        """The unresisted motions of an infeasible problem, in words."""
+        dual = result.get("dual")
+        if dual is None:
+            return {}, "the problem is infeasible (the solver gave no certificate)"
+        size = np.abs(dual).max()
+        motions, lines = {}, []
+        for j, name in enumerate(names):
+            twist = dual[:, j]
+            if size == 0.0 or np.abs(twist).max() <= 1e-6 * size:
+                continue
+            gravity = self.problem.body.weight_wrench
+            load = wrenches[:, j] + gravity
+            twist = twist if load @ twist >= 0.0 else -twist
+            screw = Screw.from_twist(twist, self.length_scale)
+            motions[name] = screw
+            lines.append(
+                f"load case {name!r} cannot be held: nothing resists the motion in which the body "
+                f"{screw.describe()}"
+            )
+        if not lines:
+            return {}, "the problem is infeasible (the certificate is empty)"
+        return motions, "; ".join(lines)
+
+
+def solve(problem: Problem, *, solver: str | None = None) -> Plan:
+    """Solve ``problem`` (see :class:`Planner`); returns a verified :class:`Plan`."""
+    return Planner(problem, solver=solver).solve()

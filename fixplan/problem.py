@@ -1,0 +1,323 @@
+"""The planner's problem description: a body, its contacts and the loads it must withstand.
+
+All values are immutable and validated on construction; errors name the contact or load and the
+field. Frames and signs follow DESIGN.md §2: positions in the world frame [m], ``normal`` points
+into the body, a contact's tangents ``t1``, ``t2`` satisfy ``t1 × t2 = normal`` and its patch
+coordinates ``(x, y)`` lie along them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fixplan import validation
+from fixplan.errors import InvalidArgumentError
+from fixplan.pressure import PressureField
+
+ROLES = ("locator", "support", "clamp", "finger")
+PASSIVE_ROLES = ("locator", "support")
+ACTIVE_ROLES = ("clamp", "finger")
+MODEL_NAMES = ("exact", "ellipsoid", "cone", "pyramid", "point-cone", "point-pyramid")
+AREA_MODEL_NAMES = ("exact", "ellipsoid", "cone", "pyramid")
+OBJECTIVES = (
+    "min-total-clamp-force",
+    "min-max-normal-force",
+    "min-total-normal-force",
+    "max-safety-factor",
+    "check",
+)
+#: Objectives that take the active forces as given.
+FIXED_FORCE_OBJECTIVES = ("max-safety-factor", "check")
+
+#: Facets of a pyramid model when none are given (the four of the paper's eq. 11).
+DEFAULT_FACETS = 4
+#: Pyramids are inscribed (conservative) unless told otherwise.
+DEFAULT_INSCRIBED = True
+
+
+class ProblemError(InvalidArgumentError):
+    """A problem description is invalid; the message names the item and field."""
+
+
+def _vector(where: str, value: object, *, unit: bool = False) -> np.ndarray:
+    try:
+        array = validation.finite_array(where, value, shape=(3,))
+    except InvalidArgumentError as exc:
+        raise ProblemError(str(exc)) from None
+    if unit:
+        length = float(np.linalg.norm(array))
+        if length == 0.0:
+            raise ProblemError(f"{where} must be a nonzero direction, got {array.tolist()}")
+        array = array / length
+        array.setflags(write=False)
+    return array
+
+
+def _scalar(where: str, value: object, *, positive: bool = False) -> float:
+    try:
+        check = validation.positive_scalar if positive else validation.nonnegative_scalar
+        return check(where, value)
+    except InvalidArgumentError as exc:
+        raise ProblemError(str(exc)) from None
+
+
+def _name(where: str, value: object) -> str:
+    if not isinstance(value, str) or not value.strip():
+        raise ProblemError(f"{where} must be a non-empty string, got {value!r}")
+    return value
+
+
+def default_axis(normal: np.ndarray) -> np.ndarray:
+    """The default patch x axis: the world axis least aligned with ``normal`` (x, then y, then
+    z on ties), projected onto the contact plane and normalised."""
+    axis = np.eye(3)[int(np.argmin(np.abs(normal)))]
+    tangent = axis - (axis @ normal) * normal
+    return tangent / np.linalg.norm(tangent)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Body:
+    """A rigid body.
+
+    Attributes
+    ----------
+    mass : float
+        Mass [kg], >= 0.
+    center_of_mass : array (3,)
+        Centre of mass in the world frame [m].
+    gravity : array (3,)
+        Gravitational acceleration [m/s²]; zero turns gravity off.
+    """
+
+    mass: float
+    center_of_mass: np.ndarray
+    gravity: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, -9.81]))
+
+    def __post_init__(self):
+        object.__setattr__(self, "mass", _scalar("body.mass", self.mass))
+        object.__setattr__(
+            self, "center_of_mass", _vector("body.center_of_mass", self.center_of_mass)
+        )
+        object.__setattr__(self, "gravity", _vector("body.gravity", self.gravity))
+
+    @property
+    def weight_wrench(self) -> np.ndarray:
+        """Gravity wrench ``(force [N], moment about the world origin [N m])``."""
+        force = self.mass * self.gravity
+        return np.concatenate([force, np.cross(self.center_of_mass, force)])
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Load:
+    """A task load: ``force`` [N] applied at ``point`` [m] plus a pure ``torque`` [N m]."""
+
+    name: str
+    force: np.ndarray
+    point: np.ndarray
+    torque: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+    def __post_init__(self):
+        where = f"load {self.name!r}" if isinstance(self.name, str) else "load"
+        _name(f"{where}.name", self.name)
+        object.__setattr__(self, "force", _vector(f"{where}.force", self.force))
+        object.__setattr__(self, "point", _vector(f"{where}.point", self.point))
+        object.__setattr__(self, "torque", _vector(f"{where}.torque", self.torque))
+
+    @property
+    def wrench(self) -> np.ndarray:
+        """``(force, moment about the world origin)`` [N, N m]."""
+        return np.concatenate([self.force, np.cross(self.point, self.force) + self.torque])
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Contact:
+    """A frictional contact between the body and a locator, support, clamp or finger.
+
+    Attributes
+    ----------
+    name : str
+        Unique name.
+    role : str
+        ``"locator"``/``"support"`` (passive: its normal force is a reaction, per load case),
+        ``"clamp"`` (active: one force for all load cases) or ``"finger"`` (active: a force per
+        load case).
+    position : array (3,)
+        Contact point, the origin of the patch coordinates [m].
+    normal : array (3,)
+        Direction in which the contact pushes the body (into the body); normalised.
+    mu : float
+        Friction coefficient, > 0.
+    model : str or friction model
+        ``"exact"``, ``"ellipsoid"``, ``"cone"``, ``"pyramid"`` (need a ``patch``),
+        ``"point-cone"``, ``"point-pyramid"``, or a model object from :mod:`fixplan.models`
+        built for unit normal force.
+    patch : PressureField, optional
+        Pressure distribution of an area contact; its torsional friction and limit-surface
+        shape come from it. Required by the area models.
+    axis : array (3,), optional
+        World direction of the patch x axis, projected onto the contact plane. Default:
+        :func:`default_axis`.
+    facets, inscribed : int, bool, optional
+        Pyramid models only: number of facets (default 4) and whether the pyramid is inscribed
+        in the exact set (conservative, default) or circumscribed.
+    force : float, optional
+        Fixed normal force of an active contact [N].
+    max_force : float, optional
+        Upper bound on an active contact's normal force [N].
+    """
+
+    name: str
+    role: str
+    position: np.ndarray
+    normal: np.ndarray
+    mu: float
+    model: object
+    patch: PressureField | None = None
+    axis: np.ndarray | None = None
+    facets: int | None = None
+    inscribed: bool | None = None
+    force: float | None = None
+    max_force: float | None = None
+
+    def __post_init__(self):
+        where = f"contact {self.name!r}" if isinstance(self.name, str) else "contact"
+        _name(f"{where}.name", self.name)
+        if self.role not in ROLES:
+            raise ProblemError(
+                f"{where}.role must be one of {', '.join(ROLES)}; got {self.role!r}"
+            )
+        object.__setattr__(self, "position", _vector(f"{where}.position", self.position))
+        object.__setattr__(self, "normal", _vector(f"{where}.normal", self.normal, unit=True))
+        object.__setattr__(self, "mu", _scalar(f"{where}.mu", self.mu, positive=True))
+        if self.patch is not None and not isinstance(self.patch, PressureField):
+            raise ProblemError(f"{where}.patch must be a pressure field, got {self.patch!r}")
+        self._check_model(where)
+        if self.axis is not None:
+            axis = _vector(f"{where}.axis", self.axis)
+            tangent = axis - (axis @ self.normal) * self.normal
+            if np.linalg.norm(tangent) <= 1e-9 * np.linalg.norm(axis):
+                raise ProblemError(f"{where}.axis must not be parallel to the normal")
+            object.__setattr__(self, "axis", tangent / np.linalg.norm(tangent))
+        for key in ("force", "max_force"):
+            value = getattr(self, key)
+            if value is not None:
+                if self.role in PASSIVE_ROLES:
+                    raise ProblemError(
+                        f"{where}.{key} is only for active contacts (clamp, finger); a "
+                        f"{self.role}'s normal force is a reaction"
+                    )
+                object.__setattr__(self, key, _scalar(f"{where}.{key}", value))
+        if self.force is not None and self.max_force is not None and self.force > self.max_force:
+            raise ProblemError(f"{where}.force {self.force} exceeds max_force {self.max_force}")
+
+    def _check_model(self, where: str) -> None:
+        model = self.model
+        if isinstance(model, str):
+            if model not in MODEL_NAMES:
+                raise ProblemError(
+                    f"{where}.model must be one of {', '.join(MODEL_NAMES)} or a model object; "
+                    f"got {model!r}"
+                )
+            if model in AREA_MODEL_NAMES and self.patch is None:
+                raise ProblemError(
+                    f"{where}.model {model!r} needs a patch (pressure field); use 'point-cone' "
+                    "or 'point-pyramid' for a point contact"
+                )
+            pyramid = model in ("pyramid", "point-pyramid")
+        else:
+            if not hasattr(model, "constraints"):
+                raise ProblemError(f"{where}.model must be a model name or object, got {model!r}")
+            pyramid = False
+        if not pyramid and (self.facets is not None or self.inscribed is not None):
+            raise ProblemError(f"{where}.facets and .inscribed are only for pyramid models")
+        if self.facets is not None:
+            if not isinstance(self.facets, int | np.integer) or self.facets < 3:
+                raise ProblemError(f"{where}.facets must be an integer >= 3, got {self.facets!r}")
+        if self.inscribed is not None and not isinstance(self.inscribed, bool | np.bool_):
+            raise ProblemError(f"{where}.inscribed must be true or false, got {self.inscribed!r}")
+
+    @property
+    def is_active(self) -> bool:
+        """Whether the contact's normal force is chosen (clamp, finger)."""
+        return self.role in ACTIVE_ROLES
+
+    @property
+    def frame(self) -> np.ndarray:
+        """Rows ``t1, t2, normal`` of the contact frame (world directions)."""
+        t1 = self.axis if self.axis is not None else default_axis(self.normal)
+        t2 = np.cross(self.normal, t1)
+        return np.array([t1, t2, self.normal])
+
+    @property
+    def has_torsion(self) -> bool:
+        """Whether the contact transmits a moment about its normal (area models)."""
+        if isinstance(self.model, str):
+            return self.model in AREA_MODEL_NAMES
+        return getattr(self.model, "torsion", True)
+
+    def wrench_basis(self) -> np.ndarray:
+        """Map ``(6, 4)`` from ``(fn, ft1, ft2, mn)`` to the body wrench about the world origin."""
+        t1, t2, n = self.frame
+        p = self.position
+        columns = [
+            np.concatenate([n, np.cross(p, n)]),
+            np.concatenate([t1, np.cross(p, t1)]),
+            np.concatenate([t2, np.cross(p, t2)]),
+            np.concatenate([np.zeros(3), n]),
+        ]
+        return np.column_stack(columns)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Problem:
+    """A planning problem: a body, its contacts, the task loads and the objective."""
+
+    body: Body
+    contacts: tuple[Contact, ...]
+    loads: tuple[Load, ...]
+    objective: str
+
+    def __post_init__(self):
+        if not isinstance(self.body, Body):
+            raise ProblemError(f"body must be a Body, got {type(self.body).__name__}")
+        contacts = tuple(self.contacts)
+        loads = tuple(self.loads)
+        if not contacts:
+            raise ProblemError("contacts must hold at least one contact")
+        if not loads:
+            raise ProblemError("loads must hold at least one load case")
+        for kind, items, cls in (("contact", contacts, Contact), ("load", loads, Load)):
+            names = set()
+            for index, item in enumerate(items):
+                if not isinstance(item, cls):
+                    raise ProblemError(f"{kind}s[{index}] must be a {cls.__name__}")
+                if item.name in names:
+                    raise ProblemError(f"{kind} name {item.name!r} is used twice")
+                names.add(item.name)
+        if self.objective not in OBJECTIVES:
+            raise ProblemError(
+                f"objective must be one of {', '.join(OBJECTIVES)}; got {self.objective!r}"
+            )
+        if self.objective in FIXED_FORCE_OBJECTIVES:
+            for contact in contacts:
+                if contact.is_active and contact.force is None:
+                    raise ProblemError(
+                        f"contact {contact.name!r}.force is required: objective "
+                        f"{self.objective!r} takes the active forces as given"
+                    )
+        elif self.objective == "min-total-clamp-force" and not any(
+            c.role == "clamp" and c.force is None for c in contacts
+        ):
+            raise ProblemError(
+                "objective 'min-total-clamp-force' needs at least one clamp whose force is free"
+            )
+        elif not any(c.is_active and c.force is None for c in contacts):
+            raise ProblemError(
+                f"objective {self.objective!r} needs at least one clamp or finger whose force is free"
+            )
+        object.__setattr__(self, "contacts", contacts)
+        object.__setattr__(self, "loads", loads)
+
+

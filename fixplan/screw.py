@@ -1,0 +1,87 @@
+"""Rigid-body twists as screws, and in words.
+
+A twist ``(v, ω)`` is the velocity ``v`` [m/s] of the body point at the world origin and the
+angular velocity ``ω`` [rad/s]. Its screw is the axis along ``ω`` through the point
+``r = ω × v / |ω|²`` with pitch ``ω·v / |ω|²`` [m/rad]; a twist with ``ω = 0`` is a translation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: A twist whose rotation moves points at this distance [m] less than this fraction of its
+#: translation is reported as a pure translation.
+TRANSLATION_RTOL = 1e-9
+
+
+def _fmt(vector: np.ndarray, digits: int = 4) -> str:
+    cleaned = np.where(np.abs(vector) < 10.0 ** (-digits - 2) * np.max(np.abs(vector)), 0.0, vector)
+    return "(" + ", ".join(f"{x:.{digits}g}" for x in cleaned + 0.0) + ")"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Screw:
+    """A unit twist and its screw.
+
+    Attributes
+    ----------
+    twist : array (6,)
+        ``(v, ω)``: velocity of the body point at the world origin [m/s] and angular velocity
+        [rad/s], scaled so that ``|v|² + (L |ω|)² = 1`` with ``L`` the body's length scale.
+    direction : array (3,)
+        Unit direction of the screw axis (of the translation for a pure translation).
+    point : array (3,) or None
+        Point of the axis closest to the world origin [m] (``None`` for a translation).
+    pitch : float
+        Translation per radian along the axis [m/rad] (``inf`` for a translation).
+    """
+
+    twist: np.ndarray
+    direction: np.ndarray
+    point: np.ndarray | None
+    pitch: float
+
+    @classmethod
+    def from_twist(cls, twist: np.ndarray, length_scale: float) -> Screw:
+        """The screw of ``twist`` ``(6,)``; ``length_scale`` [m] sets the translation test."""
+        v, omega = np.asarray(twist[:3], float), np.asarray(twist[3:], float)
+        norm = np.sqrt(v @ v + (length_scale**2) * (omega @ omega))
+        v, omega = v / norm, omega / norm
+        spin = float(np.linalg.norm(omega))
+        if spin * length_scale <= TRANSLATION_RTOL * np.linalg.norm(v):
+            return cls(
+                twist=np.concatenate([v, np.zeros(3)]),
+                direction=v / np.linalg.norm(v),
+                point=None,
+                pitch=float("inf"),
+            )
+        direction = omega / spin
+        point = np.cross(omega, v) / spin**2
+        pitch = float(omega @ v) / spin**2
+        return cls(twist=np.concatenate([v, omega]), direction=direction, point=point, pitch=pitch)
+
+    @property
+    def is_translation(self) -> bool:
+        """Whether the body slides without turning."""
+        return self.point is None
+
+    def describe(self) -> str:
+        """The motion in words."""
+        if self.is_translation:
+            return f"translates along {_fmt(self.direction)}"
+        text = f"rotates about an axis through {_fmt(self.point)} m along {_fmt(self.direction)}"
+        if abs(self.pitch) > 1e-9:
+            text += f", advancing {self.pitch:.4g} m/rad along it"
+        return text
+
+    def as_dict(self) -> dict:
+        """JSON-ready description."""
+        return {
+            "twist": self.twist.tolist(),
+            "axis_direction": self.direction.tolist(),
+            "axis_point_m": None if self.point is None else self.point.tolist(),
+            "pitch_m_per_rad": None if self.is_translation else self.pitch,
+            "words": self.describe(),
+        }
