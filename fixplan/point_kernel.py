@@ -17,7 +17,6 @@ from fixplan.kernels import SupportKernel
 _JIT = {"cache": True, "fastmath": {"reassoc", "contract"}, "nogil": True}
 
 
-@numba.njit(parallel=True, **_JIT)
 def _evaluate(px, py, pw, twists, out_h, out_loads):  # pragma: no cover - compiled
     for k in numba.prange(twists.shape[0]):
         vx, vy, w = twists[k, 0], twists[k, 1], twists[k, 2]
@@ -43,7 +42,6 @@ def _evaluate(px, py, pw, twists, out_h, out_loads):  # pragma: no cover - compi
         out_loads[k, 2] = m
 
 
-@numba.njit(parallel=True, **_JIT)
 def _newton_terms(px, py, pw, twists, out_h, out_g, out_hess):  # pragma: no cover - compiled
     for k in numba.prange(twists.shape[0]):
         vx, vy, w = twists[k, 0], twists[k, 1], twists[k, 2]
@@ -97,6 +95,24 @@ def _newton_terms(px, py, pw, twists, out_h, out_g, out_hess):  # pragma: no cov
         out_hess[k, 2, 2] = h22
 
 
+#: Below this many (point, twist) pairs a call runs on one thread: waking the thread pool costs
+#: more than the work, and far more when the other cores are busy.
+PARALLEL_MIN_WORK = 200_000
+
+
+def _compiled(function):
+    """A function compiled twice: (serial, parallel)."""
+    return numba.njit(parallel=False, **_JIT)(function), numba.njit(parallel=True, **_JIT)(function)
+
+
+_EVALUATE = _compiled(_evaluate)
+_NEWTON_TERMS = _compiled(_newton_terms)
+
+
+def _pick(variants, twists: int, points: int):
+    return variants[twists > 1 and twists * points >= PARALLEL_MIN_WORK]
+
+
 @dataclass(frozen=True, slots=True)
 class PointSetKernel(SupportKernel):
     """Points ``(n, 2)`` [m] with friction weights ``(n,)`` (summing to the total friction).
@@ -130,7 +146,7 @@ class PointSetKernel(SupportKernel):
         twists = np.ascontiguousarray(twists, dtype=float)
         h = np.empty(len(twists))
         loads = np.empty((len(twists), 3))
-        _evaluate(self._x, self._y, self.weights, twists, h, loads)
+        _pick(_EVALUATE, len(twists), len(self._x))(self._x, self._y, self.weights, twists, h, loads)
         return h, loads
 
     def newton_terms(self, twists):
@@ -138,14 +154,15 @@ class PointSetKernel(SupportKernel):
         h = np.empty(len(twists))
         g = np.empty((len(twists), 3))
         hess = np.empty((len(twists), 3, 3))
-        _newton_terms(self._x, self._y, self.weights, twists, h, g, hess)
+        _pick(_NEWTON_TERMS, len(twists), len(self._x))(
+            self._x, self._y, self.weights, twists, h, g, hess
+        )
         return h, g, hess
 
     def hessian(self, twists):
         return self.newton_terms(twists)[2]
 
 
-@numba.njit(parallel=True, **_JIT)
 def _slowest(px, py, pw, twists, out_index, out_speed):  # pragma: no cover - compiled
     count = out_index.shape[1]
     for k in numba.prange(twists.shape[0]):
@@ -167,6 +184,9 @@ def _slowest(px, py, pw, twists, out_index, out_speed):  # pragma: no cover - co
                 out_index[k, j] = i
 
 
+_SLOWEST = _compiled(_slowest)
+
+
 def slowest_points(
     points: np.ndarray, weights: np.ndarray, twists: np.ndarray, count: int
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -175,7 +195,7 @@ def slowest_points(
     count = min(count, len(points))
     index = np.empty((len(twists), count), dtype=np.int64)
     speed = np.empty((len(twists), count))
-    _slowest(
+    _pick(_SLOWEST, len(twists), len(points))(
         np.ascontiguousarray(points[:, 0]),
         np.ascontiguousarray(points[:, 1]),
         np.ascontiguousarray(weights, dtype=float),

@@ -38,3 +38,15 @@ FRICTION_SET_RTOL = 1e-6
 
 #: Fixed-force objectives cap each load scale here; reaching the cap means "any multiple".
 MAX_SAFETY_FACTOR = 1e6
+
+#: Smallest eigenvalue of a fitted ellipsoid's matrix in normalised coordinates: keeps the fit
+#: positive definite (a bounded set) when the data leave a direction unconstrained.
+FIT_MIN_EIGENVALUE = 1e-6
+
+#: A component of the normalised force at maximum moment below this is rounding noise of a
+#: symmetric pressure field; the ellipsoid, cone and pyramid are then not tilted.
+TILT_ATOL = 1e-12
+
+#: A model overestimates the limit surface ("unsafe") in a direction where its radius exceeds
+#: the exact one by more than this fraction (the exact inverse map is accurate to ~1e-15).
+UNSAFE_RTOL = 1e-9

@@ -1,0 +1,37 @@
+"""The friction model of each planner contact, at unit normal force.
+
+Area models are built from the exact limit surface of the contact's patch (its pressure shape
+and ``mu``), so the torsional friction comes from the patch, never from a guessed coefficient.
+"""
+
+from __future__ import annotations
+
+from fixplan.limit_surface import LimitSurface
+from fixplan.model_base import FrictionModel
+from fixplan.models import Cone, Ellipsoid, Exact, PointCone, PointPyramid, Pyramid
+from fixplan.problem import DEFAULT_FACETS, DEFAULT_INSCRIBED, Contact
+
+#: Quadrature order of the "exact" model in the planner: 128 friction disks per disk or
+#: rectangle patch, about 1e-3 from the continuous surface (reported by the model).
+PLANNER_EXACT_ORDER = 8
+
+
+def contact_model(contact: Contact) -> FrictionModel:
+    """The friction model of ``contact`` for unit normal force."""
+    model = contact.model
+    if not isinstance(model, str):
+        return model
+    facets = DEFAULT_FACETS if contact.facets is None else int(contact.facets)
+    inscribed = DEFAULT_INSCRIBED if contact.inscribed is None else bool(contact.inscribed)
+    if model == "point-cone":
+        return PointCone(mu=contact.mu)
+    if model == "point-pyramid":
+        return PointPyramid(mu=contact.mu, facets=facets, inscribed=inscribed)
+    surface = LimitSurface(contact.patch, mu=contact.mu, normal_force=1.0)
+    if model == "ellipsoid":
+        return Ellipsoid.from_limit_surface(surface)
+    if model == "cone":
+        return Cone.from_limit_surface(surface)
+    if model == "pyramid":
+        return Pyramid.from_limit_surface(surface, facets=facets, inscribed=inscribed)
+    return Exact.from_limit_surface(surface, order=PLANNER_EXACT_ORDER)
