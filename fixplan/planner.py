@@ -173,10 +173,14 @@ class Planner:
                 total = total + cp.max(cp.sum(cp.vstack(free_fingers), axis=0))
             return cp.Minimize(total)
         active_forces = normal[active, :]
+        # Without a free clamp the load cases are independent: minimising the sum of the per-case
+        # worst values gives every case its own least forces, and the largest of them is the
+        # min-max. A free clamp couples the cases, and then the max is minimised directly.
+        worst = cp.max if free_clamps else cp.sum
         if objective == "min-max-normal-force":
-            return cp.Minimize(cp.max(active_forces))
+            return cp.Minimize(worst(cp.max(active_forces, axis=0)))
         if objective == "min-total-normal-force":
-            return cp.Minimize(cp.max(cp.sum(active_forces, axis=0)))
+            return cp.Minimize(worst(cp.sum(active_forces, axis=0)))
         return cp.Minimize(cp.sum_squares(active_forces))  # min-squared-normal-force
 
     # -- solving ------------------------------------------------------------------------------
@@ -307,8 +311,9 @@ class Planner:
         residual = normal_part + friction_part + task_part + gravity
         magnitude = np.abs(normal_part) + np.abs(friction_part) + np.abs(task_part) + np.abs(gravity)
         relative = 0.0
-        for rows, unit in ((slice(0, 3), "N"), (slice(3, 6), "N m")):
-            size = max(float(magnitude[rows].max()), 1e-12)
+        force_size = max(float(magnitude[:3].max()), 1e-12)
+        sizes = (force_size, max(float(magnitude[3:].max()), force_size * self.length_scale))
+        for rows, unit, size in ((slice(0, 3), "N", sizes[0]), (slice(3, 6), "N m", sizes[1])):
             worst = float(np.abs(residual[rows]).max())
             relative = max(relative, worst / size)
             if worst > EQUILIBRIUM_RTOL * size:

@@ -1,0 +1,285 @@
+"""The convex planner against analytic cases, ordering laws and its own contracts."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from fixplan import LimitSurface, pressure
+from fixplan.contact_models import contact_model
+from fixplan.contact_surface import ContactSetSurface
+from fixplan.errors import FixplanError, InvalidArgumentError
+from fixplan.models import Ellipsoid
+from fixplan.planner import Planner, solve
+from fixplan.problem import Body, Contact, Load, Problem, ProblemError
+
+MU, RADIUS, HALF_GAP = 0.5, 0.01, 0.02
+WEIGHTLESS = Body(mass=0.0, center_of_mass=[0, 0, 0])
+
+
+def pinch(model, *, load, objective="min-max-normal-force", patch=None, role="finger", **extra):
+    """Two fingers squeezing a bar along y, at (0, ∓HALF_GAP, 0)."""
+    patch = pressure.disk(RADIUS) if patch is None and not model.startswith("point") else patch
+    contacts = [
+        Contact(
+            name=name,
+            role=role,
+            position=[0, side * HALF_GAP, 0],
+            normal=[0, -side, 0],
+            mu=MU,
+            model=model,
+            patch=patch,
+            **extra,
+        )
+        for name, side in (("left", -1), ("right", 1))
+    ]
+    loads = load if isinstance(load, list) else [load]
+    return Problem(body=WEIGHTLESS, contacts=contacts, loads=loads, objective=objective)
+
+
+def off_axis_load(weight=10.0, offset=0.03):
+    """A downward force acting ``offset`` [m] from the grasp axis along x."""
+    return Load(name="off-axis", force=[0, 0, -weight], point=[offset, 0, 0])
+
+
+@pytest.mark.parametrize("offset", [0.0, 0.01, 0.03, 0.1])
+def test_ellipsoid_pinch_needs_the_closed_form_grip_force(offset):
+    # Each finger carries half the force F/2 and half the torsion F d/2; the ellipsoid
+    # (f/(mu N))² + (m/(mu k R N))² <= 1 with k = 2/3 (uniform disk) gives N in closed form.
+    plan = solve(pinch("ellipsoid", load=off_axis_load(offset=offset)))
+    f, m = 10.0 / 2, 10.0 * offset / 2
+    expected = np.hypot(f / MU, m / (MU * 2 / 3 * RADIUS))
+    assert plan.status == "optimal"
+    assert plan.objective_value == pytest.approx(expected, rel=1e-7)
+    assert plan.safety_factor == pytest.approx(1.0, rel=1e-6)
+
+
+@pytest.mark.parametrize("offset", [0.0, 0.01, 0.03, 0.1])
+def test_cone_pinch_needs_the_closed_form_grip_force(offset):
+    plan = solve(pinch("cone", load=off_axis_load(offset=offset)))
+    expected = (10.0 / 2) / MU + (10.0 * offset / 2) / (MU * 2 / 3 * RADIUS)
+    assert plan.objective_value == pytest.approx(expected, rel=1e-7)
+
+
+def test_pinch_slides_by_turning_about_the_grasp_axis():
+    plan = solve(pinch("ellipsoid", load=off_axis_load(offset=0.03)))
+    motion = plan.motions["off-axis"]
+    assert not motion.is_translation
+    assert abs(motion.direction @ [0, 1, 0]) == pytest.approx(1.0, abs=1e-6)
+    assert "rotates about an axis through" in motion.describe()
+
+
+def test_torque_about_the_axis_of_a_point_contact_pinch_is_infeasible_with_that_certificate():
+    torque = Load(name="twist", force=[0, 0, 0], point=[0, 0, 0], torque=[0, 1.0, 0])
+    plan = solve(pinch("point-cone", load=torque))
+    assert plan.status == "infeasible"
+    motion = plan.infeasible_motions["twist"]
+    assert abs(motion.direction @ [0, 1, 0]) == pytest.approx(1.0, abs=1e-6)
+    assert np.linalg.norm(motion.point) < 1e-6
+    assert "'twist' cannot be held" in plan.certificate
+
+
+def block_on_plate(patch, model, push):
+    support = Contact(
+        name="base", role="support", position=[0, 0, 0], normal=[0, 0, 1], mu=MU, model=model,
+        patch=patch,
+    )  # fmt: skip
+    body = Body(mass=2.0, center_of_mass=[0, 0, 0.05])
+    return Problem(body=body, contacts=[support], loads=[push], objective="max-safety-factor")
+
+
+PUSH = Load(name="push", force=[3.0, -1.0, 0.0], point=[0.01, 0.02, 0.0], torque=[0, 0, 0.05])
+
+
+def planar_load(load):
+    """(fx, fy, mz) of a load in the base patch frame (the world x, y at z = 0)."""
+    wrench = load.wrench
+    return np.array([wrench[0], wrench[1], wrench[5]])
+
+
+def test_block_on_point_supports_has_the_safety_factor_of_its_planar_limit_surface():
+    patch = pressure.points([[0.03, 0.0], [-0.02, 0.025], [-0.02, -0.03]], [1.0, 2.0, 1.5])
+    plan = solve(block_on_plate(patch, "exact", PUSH))
+    surface = LimitSurface(patch, mu=MU, normal_force=2.0 * 9.81)
+    assert plan.status == "optimal"
+    assert plan.safety_factors["push"] == pytest.approx(
+        surface.safety_factor(planar_load(PUSH)), rel=1e-6
+    )
+
+
+def test_block_on_a_rectangle_matches_its_planar_limit_surface_within_the_quadrature_error():
+    patch = pressure.rectangle(0.08, 0.03)
+    model = contact_model(block_on_plate(patch, "exact", PUSH).contacts[0])
+    plan = solve(block_on_plate(patch, "exact", PUSH))
+    surface = LimitSurface(patch, mu=MU, normal_force=2.0 * 9.81)
+    exact = surface.safety_factor(planar_load(PUSH))
+    assert abs(plan.safety_factors["push"] / exact - 1.0) <= 2.0 * model.quadrature_error
+
+
+def test_block_with_an_ellipsoid_base_matches_the_ellipsoid_model():
+    patch = pressure.rectangle(0.08, 0.03)
+    plan = solve(block_on_plate(patch, "ellipsoid", PUSH))
+    model = Ellipsoid.from_limit_surface(LimitSurface(patch, mu=MU, normal_force=2.0 * 9.81))
+    assert plan.safety_factors["push"] == pytest.approx(
+        model.safety_factor(planar_load(PUSH)), rel=1e-6
+    )
+
+
+def test_conservative_models_never_need_less_grip_than_the_exact_model():
+    load = off_axis_load(offset=0.02)
+    exact = solve(pinch("exact", load=load)).objective_value
+    for model in ("cone", "pyramid"):
+        assert solve(pinch(model, load=load)).objective_value >= exact * (1 - 1e-6)
+
+
+@pytest.mark.parametrize("facets", [4, 6, 8, 16])
+def test_inscribed_pyramid_never_below_coulomb_cone_and_circumscribed_never_above(facets):
+    load = Load(name="slanted", force=[0.0, 0.0, -10.0], point=[0, 0, 0], torque=[0, 0, 0])
+    tilt = Load(name="tilted", force=[2.0, 0.0, -7.0], point=[0, 0, 0])
+    cone = solve(pinch("point-cone", load=[load, tilt])).objective_value
+    inner = solve(pinch("point-pyramid", load=[load, tilt], facets=facets, inscribed=True))
+    outer = solve(pinch("point-pyramid", load=[load, tilt], facets=facets, inscribed=False))
+    assert inner.objective_value >= cone * (1 - 1e-7)
+    assert outer.objective_value <= cone * (1 + 1e-7)
+
+
+def test_a_shared_clamp_force_holds_the_worst_load_case():
+    cases = [off_axis_load(weight=w, offset=0.0) for w in (2.0, 8.0, 5.0)]
+    cases = [Load(name=f"w{k}", force=c.force, point=c.point) for k, c in enumerate(cases)]
+    problem = pinch("point-cone", load=cases, objective="min-total-clamp-force", role="clamp")
+    plan = solve(problem)
+    # Two clamps, each at least 8/2/mu; their sum is minimised.
+    assert plan.objective_value == pytest.approx(2 * 8.0 / 2 / MU, rel=1e-7)
+    assert plan.safety_factors["w1"] == pytest.approx(1.0, rel=1e-6)
+    assert plan.safety_factors["w0"] == pytest.approx(8.0 / 2.0, rel=1e-6)
+
+
+def test_fingers_adapt_their_force_to_each_load_case():
+    cases = [
+        Load(name=f"w{k}", force=[0, 0, -w], point=[0, 0, 0]) for k, w in enumerate((2.0, 8.0))
+    ]
+    plan = solve(pinch("point-cone", load=cases))
+    assert plan.forces["left"] == pytest.approx([2.0 / 2 / MU, 8.0 / 2 / MU], rel=1e-6)
+
+
+def test_resolving_with_new_loads_reuses_the_compiled_problem():
+    problem = pinch("ellipsoid", load=off_axis_load())
+    planner = Planner(problem)
+    first = planner.solve(analyse=False)
+    compiled = planner._built[problem.objective].problem
+    doubled = planner.solve([off_axis_load(weight=20.0)], analyse=False)
+    assert planner._built[problem.objective].problem is compiled
+    assert doubled.objective_value == pytest.approx(2 * first.objective_value, rel=1e-7)
+
+
+def test_max_safety_factor_scales_the_task_load_not_gravity():
+    body = Body(mass=1.0, center_of_mass=[0, 0, 0])
+    contacts = [
+        Contact(name=n, role="clamp", position=[0, s * HALF_GAP, 0], normal=[0, -s, 0], mu=MU,
+                model="point-cone", force=50.0)
+        for n, s in (("a", -1), ("b", 1))
+    ]  # fmt: skip
+    push = Load(name="down", force=[0, 0, -10.0], point=[0, 0, 0])
+    plan = solve(Problem(body=body, contacts=contacts, loads=[push], objective="max-safety-factor"))
+    # Friction holds 2 * mu * 50 = 50 N vertically; gravity takes 9.81 N of it.
+    assert plan.safety_factor == pytest.approx((50.0 - 9.81) / 10.0, rel=1e-6)
+
+
+def test_check_reports_held_and_utilisation():
+    contacts = [
+        Contact(name=n, role="clamp", position=[0, s * HALF_GAP, 0], normal=[0, -s, 0], mu=MU,
+                model="ellipsoid", patch=pressure.disk(RADIUS), force=20.0)
+        for n, s in (("a", -1), ("b", 1))
+    ]  # fmt: skip
+    loads = [
+        off_axis_load(weight=5.0, offset=0.005),
+        Load(name="heavy", force=[0, 0, -40.0], point=[0, 0, 0]),
+    ]
+    plan = solve(Problem(body=WEIGHTLESS, contacts=contacts, loads=loads, objective="check"))
+    assert plan.held == {"off-axis": True, "heavy": False}
+    assert plan.safety_factors["heavy"] == pytest.approx(20.0 / 40.0, rel=1e-6)
+    assert plan.critical_load == "heavy"
+    assert np.max(plan.utilisation) == pytest.approx(1.0, rel=1e-5)
+
+
+def test_osqp_solves_pyramid_problems_like_clarabel():
+    problem = pinch("point-pyramid", load=off_axis_load(offset=0.0), facets=8)
+    clarabel = solve(problem)
+    osqp = solve(problem, solver="OSQP")
+    assert osqp.status == "optimal"
+    assert osqp.objective_value == pytest.approx(clarabel.objective_value, rel=1e-5)
+
+
+def test_osqp_refuses_conic_models_with_advice():
+    with pytest.raises(InvalidArgumentError, match="pyramid"):
+        solve(pinch("ellipsoid", load=off_axis_load()), solver="OSQP")
+
+
+def test_verification_flags_a_wrench_outside_its_friction_set():
+    planner = Planner(pinch("point-cone", load=off_axis_load(offset=0.0)))
+    normal = np.array([[10.0], [10.0]])
+    friction = np.array([[0.0], [5.0], [0.0], [6.0]])  # 6 N > mu * 10 N on the second finger
+    wrenches = np.column_stack([off_axis_load(offset=0.0).wrench])
+    _, problems = planner._verify(normal, friction, np.ones(1), wrenches)
+    assert any("'right' exceeds its friction set" in p for p in problems)
+
+
+def test_three_point_contact_set_surface_equals_the_planar_limit_surface_of_the_points():
+    xy = np.array([[0.03, 0.0], [-0.02, 0.025], [-0.02, -0.03]])
+    forces = np.array([4.0, 8.0, 6.0])
+    contacts = [
+        Contact(name=f"p{k}", role="support", position=[x, y, 0], normal=[0, 0, 1], mu=MU,
+                model="point-cone")
+        for k, (x, y) in enumerate(xy)
+    ]  # fmt: skip
+    surface = ContactSetSurface(contacts, forces, ("fx", "fy", "mz"))
+    planar = LimitSurface(pressure.points(xy, forces, centered=False), mu=MU, normal_force=18.0)
+    rng = np.random.default_rng(3)
+    for load in rng.normal(size=(5, 3)) * [1.0, 1.0, 0.05]:
+        motion, safety = surface.motion_and_safety_factor(load)
+        assert safety == pytest.approx(planar.safety_factor(load), rel=1e-6)
+        expected = planar.motion(load)
+        expected = expected / np.linalg.norm(expected)
+        assert np.linalg.norm(np.cross(motion, expected)) < 1e-4
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"normal": [0, 0, 0]}, "normal must be a nonzero direction"),
+        ({"mu": -0.1}, "mu must be > 0"),
+        ({"role": "jaw"}, "role must be one of"),
+        ({"model": "brick"}, "model must be one of"),
+        ({"role": "locator", "force": 10.0}, "force is only for active contacts"),
+        ({"position": [0, float("nan"), 0]}, "position must be finite"),
+        ({"model": "ellipsoid", "patch": None}, "needs a patch"),
+    ],
+)
+def test_bad_contacts_raise_errors_that_name_the_contact_and_field(change, message):
+    fields = dict(name="jaw", role="clamp", position=[0, 0, 0], normal=[1, 0, 0], mu=0.3,
+                  model="point-cone")  # fmt: skip
+    fields.update(change)
+    with pytest.raises(ProblemError, match=message) as error:
+        Contact(**fields)
+    assert "jaw" in str(error.value)
+    assert isinstance(error.value, FixplanError)
+
+
+def test_a_problem_without_loads_is_rejected():
+    contact = Contact(name="c", role="clamp", position=[0, 0, 0], normal=[1, 0, 0], mu=0.3,
+                      model="point-cone")  # fmt: skip
+    with pytest.raises(ProblemError, match="at least one load case"):
+        Problem(body=WEIGHTLESS, contacts=[contact], loads=[], objective="min-max-normal-force")
+
+
+def test_fixed_force_objectives_need_every_active_force():
+    with pytest.raises(ProblemError, match="force is required"):
+        pinch("point-cone", load=off_axis_load(), objective="check")
+
+
+def test_solutions_are_verified_without_warnings():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        plan = solve(pinch("exact", load=off_axis_load()))
+    assert plan.status == "optimal"
+    assert plan.residual < 1e-7
