@@ -146,8 +146,8 @@ class FrictionModel(ABC):
         """
         q, single, twisted = self._normalised(load, normal_force)
         gauge = self._gauge(q)
-        with np.errstate(divide="ignore"):
-            safety = np.where(gauge > 0.0, 1.0 / np.where(gauge > 0.0, gauge, 1.0), np.inf)
+        with np.errstate(divide="ignore", over="ignore"):
+            safety = 1.0 / gauge
         safety[twisted] = 0.0
         return float(safety[0]) if single else safety
 

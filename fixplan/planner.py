@@ -37,6 +37,8 @@ from fixplan.tolerances import (
 )
 
 SOLVERS = ("CLARABEL", "OSQP", "SCS")
+#: Load cases per compiled problem of the fixed-force objectives (their cases are independent).
+CASES_PER_BLOCK = 32
 _FALLBACK = {"CLARABEL": "SCS", "SCS": "CLARABEL", "OSQP": "CLARABEL"}
 _SOLVER_OPTIONS = {
     "CLARABEL": {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9},
@@ -108,11 +110,16 @@ class Planner:
 
     # -- building -----------------------------------------------------------------------------
 
+    def _block_size(self, objective: str) -> int:
+        """Load cases per compiled problem: fixed-force objectives split into blocks."""
+        cases = len(self.problem.loads)
+        return min(cases, CASES_PER_BLOCK) if objective in FIXED_FORCE_OBJECTIVES else cases
+
     def _build(self, objective: str) -> _Built:
         if objective in self._built:
             return self._built[objective]
         contacts = self.problem.contacts
-        cases = len(self.problem.loads)
+        cases = self._block_size(objective)
         scaling = objective in FIXED_FORCE_OBJECTIVES
         task = cp.Parameter((6, cases), name="task_wrenches")
         gravity = cp.Parameter(6, name="gravity_wrench")
@@ -258,6 +265,27 @@ class Planner:
         )
 
     def _run(self, objective: str, wrenches: np.ndarray, fixed_values: dict) -> dict:
+        """Solve all load cases, block by block for the fixed-force objectives.
+
+        Their load cases are independent (the active forces are given), so a problem compiled
+        for ``CASES_PER_BLOCK`` cases serves any number of them: each block only sets new
+        Parameter values. The last block is padded with copies of its first case.
+        """
+        cases = wrenches.shape[1]
+        block = self._block_size(objective)
+        results = []
+        for start in range(0, cases, block):
+            index = np.arange(start, min(start + block, cases))
+            padded = np.concatenate([index, np.full(block - len(index), index[0])])
+            fixed = {
+                i: (v if np.ndim(v) == 0 else np.broadcast_to(v, (cases,))[padded])
+                for i, v in fixed_values.items()
+            }
+            result = self._run_block(objective, wrenches[:, padded], fixed)
+            results.append((result, len(index)))
+        return _merge(results)
+
+    def _run_block(self, objective: str, wrenches: np.ndarray, fixed_values: dict) -> dict:
         built = self._build(objective)
         built.task.value = wrenches
         built.gravity.value = self.problem.body.weight_wrench
@@ -272,7 +300,7 @@ class Planner:
             notes.append(f"{solver} returned {status}; retried with {fallback}")
             solver = fallback
             status = self._call(built.problem, solver)
-        result = {"status": status, "solver": solver, "warnings": notes, "built": built}
+        result = {"status": status, "solver": solver, "warnings": notes}
         if status in ("optimal", "inaccurate"):
             result["normal"] = np.asarray(built.normal.value, dtype=float)
             result["friction"] = np.asarray(built.friction.value, dtype=float)
@@ -431,6 +459,45 @@ class Planner:
         if not lines:
             return {}, "the problem is infeasible (the certificate is empty)"
         return motions, "; ".join(lines)
+
+
+_SEVERITY = ("optimal", "inaccurate", "unbounded", "infeasible", "solver-error")
+
+
+def _merge(results: list[tuple[dict, int]]) -> dict:
+    """One result from the results of consecutive blocks (``(result, cases used)`` pairs)."""
+    if len(results) == 1:
+        result, used = results[0]
+        return _trim(result, used)
+    status = max((r["status"] for r, _ in results), key=_SEVERITY.index)
+    merged = {
+        "status": status,
+        "solver": ", ".join(dict.fromkeys(r["solver"] for r, _ in results)),
+        "warnings": [note for r, _ in results for note in r["warnings"]],
+    }
+    trimmed = [_trim(r, used) for r, used in results]
+    keys = ("normal", "friction", "scale", "dual")
+    for key in keys:
+        parts = [r.get(key) for r in trimmed]
+        if status == "infeasible" and key == "dual":
+            parts = [
+                p if r["status"] == "infeasible" else np.zeros((6, used))
+                for p, r, (_, used) in zip(parts, trimmed, results, strict=True)
+            ]
+        if all(p is not None for p in parts):
+            merged[key] = np.concatenate(parts, axis=-1)
+    return merged
+
+
+def _trim(result: dict, used: int) -> dict:
+    """Drop the padding columns of a block's result."""
+    trimmed = dict(result)
+    for key in ("normal", "friction", "dual"):
+        if trimmed.get(key) is not None:
+            trimmed[key] = trimmed[key][:, :used]
+    if "scale" in trimmed:
+        trimmed["scale"] = trimmed["scale"][:used]
+    return trimmed
 
 
 def solve(problem: Problem, *, solver: str | None = None) -> Plan:

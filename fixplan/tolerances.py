@@ -36,8 +36,10 @@ EQUILIBRIUM_RTOL = 1e-6
 #: A contact wrench may exceed its friction set by this fraction before verification fails.
 FRICTION_SET_RTOL = 1e-6
 
-#: Fixed-force objectives cap each load scale here; reaching the cap means "any multiple".
-MAX_SAFETY_FACTOR = 1e6
+#: Fixed-force objectives cap each load scale here; a case that reaches the cap is reported with
+#: an infinite safety factor (held at any practical multiple). A higher cap makes the conic
+#: problems badly scaled (reactions a million times the loads).
+MAX_SAFETY_FACTOR = 1e3
 
 #: Smallest eigenvalue of a fitted ellipsoid's matrix in normalised coordinates: keeps the fit
 #: positive definite (a bounded set) when the data leave a direction unconstrained.

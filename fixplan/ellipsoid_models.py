@@ -1,0 +1,443 @@
+r"""Ellipsoidal friction models (paper §4.2, Table 2): the Table 2 ellipsoid, a fitted
+ellipsoid, and the ellipsoid with facets for discrete supports.
+
+All three have a motion map: the sliding twist is the outward normal of the ellipsoid at the
+load (maximum power), so for the axisymmetric Table 2 ellipsoid
+``|v| / w = lambda² |f| / m`` with ``lambda = max_moment / max_force`` (Table 2, step 5).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, ClassVar
+
+import numpy as np
+
+from fixplan import validation
+from fixplan.errors import ConvergenceError, InvalidArgumentError
+from fixplan.model_base import FrictionModel, finite_pair, fmt
+from fixplan.tolerances import FIT_MIN_EIGENVALUE, TILT_ATOL
+
+if TYPE_CHECKING:  # pragma: no cover
+    from fixplan.limit_surface import LimitSurface
+
+#: Default number of limit-surface samples an ellipsoid is fitted to.
+DEFAULT_FIT_SAMPLES = 1000
+
+
+def surface_units(ls: LimitSurface) -> tuple[float, float, float]:
+    """``(mu, rho, normal_force)`` of a limit surface: friction per unit normal force [-],
+    characteristic length [m] and normal force [N]."""
+    from fixplan.limit_surface import LimitSurface
+
+    if not isinstance(ls, LimitSurface):
+        raise InvalidArgumentError(
+            f"ls must be a fixplan.LimitSurface, got {type(ls).__name__}; build one with "
+            "LimitSurface(field, mu=..., normal_force=...)"
+        )
+    return ls.max_force / ls.normal_force, ls.characteristic_length, ls.normal_force
+
+
+def surface_tilt(ls: LimitSurface) -> tuple[float, float]:
+    """Force ``(fx0, fy0)`` of the load at maximum moment, over ``max_force`` (Table 2, step 2).
+
+    Components below ``TILT_ATOL`` are rounding noise of a symmetric field and are set to 0.
+    """
+    force = ls.load_at_cor((0.0, 0.0))[:2] / ls.max_force
+    force = np.where(np.abs(force) < TILT_ATOL, 0.0, force)
+    return float(force[0]), float(force[1])
+
+
+def _shear(tilt: tuple[float, float]) -> np.ndarray:
+    """Matrix ``S`` with ``S q = (qx - tx qm, qy - ty qm, qm)``: the tilted axis made vertical."""
+    shear = np.eye(3)
+    shear[:2, 2] = -np.asarray(tilt)
+    return shear
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, repr=False)
+class Ellipsoid(FrictionModel):
+    r"""The ellipsoid of the paper's Table 2, built from the maximum force and moment.
+
+    In normalised coordinates ``q`` (forces over ``mu N``, moment over ``mu rho N``) the
+    axisymmetric ellipsoid is the unit sphere (Table 2, step 3). When the load at maximum
+    moment ``(fx0, fy0, m_max)`` has a force component (asymmetric pressure), the ellipsoid is
+    tilted so that its major axis runs through that load (step 2); this is done by the affine
+    shear
+
+    .. math:: \|(q_f - q_m t,\; q_m)\| \le 1, \qquad t = (f_{x0}, f_{y0}) / (\mu N),
+
+    which keeps both exact features of the limit surface: the circle of pure translation at
+    ``m = 0`` and the load at maximum moment, where the tangent plane stays horizontal as on
+    the exact surface. Motion is the ellipsoid normal (step 5).
+
+    Attributes
+    ----------
+    mu : float
+        Maximum friction force per unit normal force [-].
+    rho : float
+        Maximum moment over maximum force [m] (the paper's ``lambda``).
+    tilt : tuple of float
+        Force at maximum moment over the maximum force [-]; ``(0, 0)`` for symmetric pressure.
+    normal_force : float
+        Default normal force of the numeric methods [N].
+    """
+
+    mu: float
+    rho: float
+    tilt: tuple[float, float] = (0.0, 0.0)
+    normal_force: float = 1.0
+
+    conservative: ClassVar[bool] = False
+
+    def __post_init__(self):
+        object.__setattr__(self, "mu", validation.positive_scalar("mu", self.mu))
+        object.__setattr__(self, "rho", validation.positive_scalar("rho", self.rho))
+        object.__setattr__(self, "tilt", finite_pair("tilt", self.tilt))
+        object.__setattr__(
+            self, "normal_force", validation.positive_scalar("normal_force", self.normal_force)
+        )
+
+    @classmethod
+    def from_limit_surface(cls, ls: LimitSurface, *, tilted: bool = True) -> Ellipsoid:
+        """The Table 2 ellipsoid of an exact limit surface (steps 1-3 and 5).
+
+        With ``tilted=False`` the major axis is taken vertical even for asymmetric pressure
+        (the paper's choice when ``fx0`` and ``fy0`` are small).
+        """
+        mu, rho, normal_force = surface_units(ls)
+        tilt = surface_tilt(ls) if tilted else (0.0, 0.0)
+        return cls(mu=mu, rho=rho, tilt=tilt, normal_force=normal_force)
+
+    @classmethod
+    def from_limits(
+        cls,
+        *,
+        max_force: float,
+        max_moment: float,
+        normal_force: float = 1.0,
+        apex_force: tuple[float, float] = (0.0, 0.0),
+    ) -> Ellipsoid:
+        """From measured (or computed) maximum force [N] and moment [N m] at ``normal_force``
+        [N]; ``apex_force`` [N] is the force of the load at maximum moment (tilt)."""
+        max_force = validation.positive_scalar("max_force", max_force)
+        max_moment = validation.positive_scalar("max_moment", max_moment)
+        normal_force = validation.positive_scalar("normal_force", normal_force)
+        apex = finite_pair("apex_force", apex_force)
+        return cls(
+            mu=max_force / normal_force,
+            rho=max_moment / max_force,
+            tilt=(apex[0] / max_force, apex[1] / max_force),
+            normal_force=normal_force,
+        )
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """Matrix ``M`` (3x3) of the ellipsoid ``q^T M q <= 1`` in normalised coordinates."""
+        shear = _shear(self.tilt)
+        return shear.T @ shear
+
+    def _gauge(self, q):
+        t = self.tilt
+        fx = q[:, 0] - t[0] * q[:, 2]
+        fy = q[:, 1] - t[1] * q[:, 2]
+        return np.sqrt(fx * fx + fy * fy + q[:, 2] * q[:, 2])
+
+    def _normal(self, q):
+        return q @ self.matrix
+
+    def _unit_constraints(self, q, normal_force):
+        import cvxpy as cp
+
+        return [cp.SOC(normal_force, _shear(self.tilt) @ q)]
+
+    def __repr__(self) -> str:
+        tilt = f"({fmt(self.tilt[0])}, {fmt(self.tilt[1])})"
+        return (
+            f"Ellipsoid(mu={fmt(self.mu)}, rho={fmt(self.rho)} m, tilt={tilt}, "
+            f"normal_force={fmt(self.normal_force)} N)"
+        )
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, repr=False, eq=False)
+class FittedEllipsoid(FrictionModel):
+    r"""An ellipsoid ``q^T M q <= 1`` fitted to loads on the limit surface (or measured).
+
+    ``M`` (positive definite, any orientation) minimises
+
+    .. math:: \sum_i (q_i^T M q_i - 1)^2 \quad \text{s.t.} \quad M \succeq \epsilon I,
+
+    a convex problem (least squares over the positive-semidefinite cone, solved by cvxpy with
+    Clarabel). Near the surface ``q^T M q - 1`` is twice the relative radial gap between the
+    point and the ellipsoid, so this is a least-squares fit of the radial error, unbiased
+    between over- and under-estimates (a minimum-volume enclosing ellipsoid would always
+    overestimate and follow outliers of measured data). The centre is the origin, as every
+    limit surface is centrally symmetric.
+
+    Attributes
+    ----------
+    matrix : numpy.ndarray
+        ``M`` (3x3), in normalised coordinates ``q`` of ``mu`` and ``rho``.
+    mu, rho : float
+        Normalisation units: friction per unit normal force [-] and length [m].
+    normal_force : float
+        Default normal force of the numeric methods [N].
+    fit_error : float
+        Root-mean-square relative radial gap ``sqrt(q^T M q) - 1`` over the fitted points.
+    """
+
+    matrix: np.ndarray
+    mu: float
+    rho: float
+    normal_force: float = 1.0
+    fit_error: float = 0.0
+    _factor: np.ndarray = field(init=False)
+
+    conservative: ClassVar[bool] = False
+
+    def __post_init__(self):
+        matrix = validation.finite_array("matrix", self.matrix, shape=(3, 3))
+        if not np.allclose(matrix, matrix.T, rtol=1e-12, atol=0.0):
+            raise InvalidArgumentError("matrix must be symmetric")
+        try:
+            factor = np.linalg.cholesky(matrix).T
+        except np.linalg.LinAlgError as exc:
+            raise InvalidArgumentError("matrix must be positive definite") from exc
+        factor.setflags(write=False)
+        object.__setattr__(self, "matrix", matrix)
+        object.__setattr__(self, "_factor", factor)
+        object.__setattr__(self, "mu", validation.positive_scalar("mu", self.mu))
+        object.__setattr__(self, "rho", validation.positive_scalar("rho", self.rho))
+        object.__setattr__(
+            self, "normal_force", validation.positive_scalar("normal_force", self.normal_force)
+        )
+        object.__setattr__(
+            self, "fit_error", validation.nonnegative_scalar("fit_error", self.fit_error)
+        )
+
+    @classmethod
+    def from_limit_surface(
+        cls, ls: LimitSurface, *, samples: int = DEFAULT_FIT_SAMPLES
+    ) -> FittedEllipsoid:
+        """Fit to ``samples`` loads spread evenly over the exact surface (``ls.sample``)."""
+        if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 6:
+            raise InvalidArgumentError(f"samples must be an integer >= 6, got {samples!r}")
+        mu, rho, normal_force = surface_units(ls)
+        points = ls.sample(int(samples), normalized=True)
+        matrix, error = fit_ellipsoid(points)
+        return cls(matrix=matrix, mu=mu, rho=rho, normal_force=normal_force, fit_error=error)
+
+    @classmethod
+    def from_loads(cls, loads, *, normal_force: float) -> FittedEllipsoid:
+        """Fit to measured slip loads ``(K, 3)`` [N, N, N m] taken at ``normal_force`` [N].
+
+        At least 6 loads spanning all three directions are needed. ``mu`` and ``rho`` are
+        read off the fitted ellipsoid (its mean largest force and its largest moment).
+        """
+        loads = validation.finite_array("loads", loads, shape=(None, 3))
+        normal_force = validation.positive_scalar("normal_force", normal_force)
+        force_scale = float(np.max(np.hypot(loads[:, 0], loads[:, 1]), initial=0.0))
+        moment_scale = float(np.max(np.abs(loads[:, 2]), initial=0.0))
+        if len(loads) < 6 or force_scale == 0.0 or moment_scale == 0.0:
+            raise InvalidArgumentError(
+                "from_loads needs at least 6 loads with nonzero forces and moments, got "
+                f"{len(loads)} loads"
+            )
+        scale = np.array([force_scale, force_scale, moment_scale])
+        if np.linalg.matrix_rank(loads / scale, tol=1e-9) < 3:
+            raise InvalidArgumentError("loads must span all three directions (fx, fy, m)")
+        matrix, error = fit_ellipsoid(loads / scale)
+        # Support function of the fitted set in SI units: h(V) = sqrt(V^T B V).
+        inverse = scale[:, None] * np.linalg.inv(matrix) * scale[None, :]
+        max_force = float(np.sqrt(0.5 * (inverse[0, 0] + inverse[1, 1])))
+        max_moment = float(np.sqrt(inverse[2, 2]))
+        units = np.array([max_force, max_force, max_moment])
+        normalised = units[:, None] * np.linalg.inv(inverse) * units[None, :]
+        normalised = 0.5 * (normalised + normalised.T)
+        return cls(
+            matrix=normalised,
+            mu=max_force / normal_force,
+            rho=max_moment / max_force,
+            normal_force=normal_force,
+            fit_error=error,
+        )
+
+    def _gauge(self, q):
+        return np.linalg.norm(q @ self._factor.T, axis=1)
+
+    def _normal(self, q):
+        return q @ self.matrix
+
+    def _unit_constraints(self, q, normal_force):
+        import cvxpy as cp
+
+        return [cp.SOC(normal_force, self._factor @ q)]
+
+    def __repr__(self) -> str:
+        return (
+            f"FittedEllipsoid(mu={fmt(self.mu)}, rho={fmt(self.rho)} m, "
+            f"normal_force={fmt(self.normal_force)} N, fit_error={self.fit_error:.3g})"
+        )
+
+
+def fit_ellipsoid(points: np.ndarray) -> tuple[np.ndarray, float]:
+    """Least-squares ellipsoid ``q^T M q = 1`` through ``points`` ``(K, 3)``, centred at 0.
+
+    Returns ``M`` and the root-mean-square relative radial gap of the points. Solved with
+    Clarabel, retried once with SCS.
+    """
+    import cvxpy as cp
+
+    matrix = cp.Variable((3, 3), PSD=True)
+    residual = cp.sum(cp.multiply(points @ matrix, points), axis=1) - 1.0
+    problem = cp.Problem(
+        cp.Minimize(cp.sum_squares(residual)), [matrix >> FIT_MIN_EIGENVALUE * np.eye(3)]
+    )
+    for solver in (cp.CLARABEL, cp.SCS):
+        try:
+            problem.solve(solver=solver)
+        except cp.error.SolverError:
+            continue
+        if problem.status == cp.OPTIMAL:
+            break
+    else:
+        raise ConvergenceError(
+            f"the ellipsoid fit did not converge (status {problem.status!r} with Clarabel and "
+            "SCS); check that the points surround the origin in all three directions"
+        )
+    value = np.asarray(matrix.value)
+    value = 0.5 * (value + value.T)
+    gap = np.sqrt(np.einsum("ij,jk,ik->i", points, value, points)) - 1.0
+    return value, float(np.sqrt(np.mean(gap * gap)))
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, repr=False, eq=False)
+class FacetedEllipsoid(FrictionModel):
+    r"""An ellipsoid with the facets of discrete point supports (Table 2, step 4).
+
+    For each support point ``(xi, yi)`` the centre of rotation on that point gives a facet of
+    the exact surface: the plane with normal the twist ``Vi = (yi, -xi, 1)`` through the load
+    ``L(Vi)`` at which that point carries no force (DESIGN.md §2). The model is the
+    ellipsoid cut by these planes and their mirror images,
+
+    .. math:: |V_i \cdot L| \le h(V_i) \quad \text{for every support point } i,
+
+    where ``h`` is the exact support function. The planes are supporting planes of the exact
+    surface, so the cut removes only overestimated loads. Motion: the ellipsoid normal, or the
+    twist ``±Vi`` (rotation about point ``i``) on a facet.
+
+    Attributes
+    ----------
+    ellipsoid : Ellipsoid or FittedEllipsoid
+        The ellipsoid that is cut; it supplies ``mu``, ``rho`` and ``normal_force``.
+    points : numpy.ndarray
+        Support points ``(P, 2)`` [m].
+    facet_support : numpy.ndarray
+        ``h(Vi)`` per unit normal force ``(P,)`` [m].
+    """
+
+    ellipsoid: Ellipsoid | FittedEllipsoid
+    points: np.ndarray
+    facet_support: np.ndarray
+    _planes: np.ndarray = field(init=False)
+
+    conservative: ClassVar[bool] = False
+
+    def __post_init__(self):
+        if not isinstance(self.ellipsoid, Ellipsoid | FittedEllipsoid):
+            raise InvalidArgumentError(
+                f"ellipsoid must be an Ellipsoid or FittedEllipsoid, got {self.ellipsoid!r}"
+            )
+        points = validation.finite_array("points", self.points, shape=(None, 2))
+        support = validation.finite_array("facet_support", self.facet_support, shape=(None,))
+        if len(points) == 0 or len(support) != len(points) or np.any(support <= 0.0):
+            raise InvalidArgumentError(
+                "points (P, 2) and facet_support (P,) must have the same P >= 1, support > 0"
+            )
+        twists = np.column_stack([points[:, 1], -points[:, 0], np.ones(len(points))])
+        # Facet i in normalised coordinates: |a_i · q| <= 1, a_i = units * V_i / h_i.
+        planes = twists * self.ellipsoid._units()[None, :] / support[:, None]
+        planes.setflags(write=False)
+        object.__setattr__(self, "points", points)
+        object.__setattr__(self, "facet_support", support)
+        object.__setattr__(self, "_planes", planes)
+
+    @classmethod
+    def from_limit_surface(
+        cls,
+        ls: LimitSurface,
+        *,
+        ellipsoid: Ellipsoid | FittedEllipsoid | None = None,
+        points=None,
+    ) -> FacetedEllipsoid:
+        """Facets of the support points of ``ls`` cut from ``ellipsoid``.
+
+        ``ellipsoid`` defaults to the Table 2 ellipsoid of ``ls``. ``points`` ``(P, 2)`` [m]
+        default to the points of a discrete field (``pressure.points``, also as parts of a
+        combined surface); give them for small regions of support that act like points.
+        """
+        normal_force = surface_units(ls)[2]
+        if ellipsoid is None:
+            ellipsoid = Ellipsoid.from_limit_surface(ls)
+        if points is None:
+            points = _support_points(ls)
+            if len(points) == 0:
+                raise InvalidArgumentError(
+                    f"{ls!r} has no discrete point supports; pass points= to place facets"
+                )
+        points = validation.finite_array("points", points, shape=(None, 2))
+        twists = np.column_stack([points[:, 1], -points[:, 0], np.ones(len(points))])
+        support = np.atleast_1d(ls.support(twists)) / normal_force
+        return cls(ellipsoid=ellipsoid, points=points, facet_support=support)
+
+    @property
+    def mu(self) -> float:
+        return self.ellipsoid.mu
+
+    @property
+    def rho(self) -> float:
+        return self.ellipsoid.rho
+
+    @property
+    def normal_force(self) -> float:
+        return self.ellipsoid.normal_force
+
+    def _pieces(self, q):
+        """Gauges of the ellipsoid ``(K,)`` and of the facet pairs ``(K, P)``."""
+        return self.ellipsoid._gauge(q), np.abs(q @ self._planes.T)
+
+    def _gauge(self, q):
+        ellipsoid, facets = self._pieces(q)
+        return np.maximum(ellipsoid, facets.max(axis=1))
+
+    def _normal(self, q):
+        ellipsoid, facets = self._pieces(q)
+        normals = self.ellipsoid._normal(q)
+        best = np.argmax(facets, axis=1)
+        rows = np.arange(len(q))
+        on_facet = facets[rows, best] > ellipsoid
+        signs = np.sign(q @ self._planes.T)[rows, best]
+        normals[on_facet] = signs[on_facet, None] * self._planes[best[on_facet]]
+        return normals
+
+    def _unit_constraints(self, q, normal_force):
+        import cvxpy as cp
+
+        planes = self._planes @ q
+        return [
+            *self.ellipsoid._unit_constraints(q, normal_force),
+            cp.abs(planes) <= normal_force,
+        ]
+
+    def __repr__(self) -> str:
+        return f"FacetedEllipsoid({self.ellipsoid!r}, {len(self.points)} facet pairs)"
+
+
+def _support_points(ls: LimitSurface) -> np.ndarray:
+    """Point supports of a discrete field, or of the discrete parts of a combined surface."""
+    if ls.parts:
+        found = [_support_points(part) for part in ls.parts]
+        return np.concatenate(found) if found else np.empty((0, 2))
+    if ls.field is not None and ls.field.is_discrete:
+        return np.asarray(ls.field.quadrature()[0])
+    return np.empty((0, 2))

@@ -1,0 +1,54 @@
+"""Friction models of a contact: the exact limit surface and the paper's approximations.
+
+Every model is built from an exact :class:`~fixplan.LimitSurface` by
+``Model.from_limit_surface(ls, ...)`` and offers one interface (:class:`FrictionModel`):
+``contains``, ``safety_factor``, ``motion`` (where the model has a motion map), ``conservative``
+and ``constraints(load, normal_force)`` for cvxpy. Models are immutable values that store their
+geometry per unit normal force.
+
+============================  ==========  ======  ============  ===========================
+model                         torsion     motion  conservative  cvxpy form
+============================  ==========  ======  ============  ===========================
+:class:`Ellipsoid`            yes         yes     no            one second-order cone
+:class:`FittedEllipsoid`      yes         yes     no            one second-order cone
+:class:`FacetedEllipsoid`     yes         yes     no            cone + 2 inequalities/point
+:class:`Cone`                 yes         no      yes           norm + abs
+:class:`Pyramid`              yes         no      if inscribed  ``2k`` linear inequalities
+:class:`PointCone`            no          yes     yes           one second-order cone
+:class:`PointPyramid`         no          no      if inscribed  ``k`` linear inequalities
+:class:`Exact`                yes         yes     no (±quad.)   one small cone per point
+============================  ==========  ======  ============  ===========================
+
+Accuracy against the exact surface is measured by :func:`fixplan.compare.compare`.
+"""
+
+from fixplan.ellipsoid_models import Ellipsoid, FacetedEllipsoid, FittedEllipsoid, fit_ellipsoid
+from fixplan.exact_model import Exact
+from fixplan.model_base import FrictionModel
+from fixplan.polyhedral_models import Cone, PointCone, PointPyramid, Pyramid
+
+#: Every model class, in the order of the table above.
+MODEL_CLASSES = (
+    Ellipsoid,
+    FittedEllipsoid,
+    FacetedEllipsoid,
+    Cone,
+    Pyramid,
+    PointCone,
+    PointPyramid,
+    Exact,
+)
+
+__all__ = [
+    "MODEL_CLASSES",
+    "Cone",
+    "Ellipsoid",
+    "Exact",
+    "FacetedEllipsoid",
+    "FittedEllipsoid",
+    "FrictionModel",
+    "PointCone",
+    "PointPyramid",
+    "Pyramid",
+    "fit_ellipsoid",
+]

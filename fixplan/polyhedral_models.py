@@ -1,0 +1,341 @@
+r"""Conservative and linear friction models: the cone and pyramids of the paper (§4.2, eq. 11)
+and the Coulomb cone and pyramids of point contacts.
+
+None of them has a motion map: the normals of a cone or a pyramid do not give the sliding
+direction (paper §4.2), except for the Coulomb cone of a point, whose normal is the sliding
+direction of the point (maximum dissipation).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, ClassVar
+
+import numpy as np
+
+from fixplan import validation
+from fixplan.ellipsoid_models import _shear, surface_tilt, surface_units
+from fixplan.model_base import FrictionModel, facet_count, finite_pair, fmt, polygon_normals
+
+if TYPE_CHECKING:  # pragma: no cover
+    from fixplan.limit_surface import LimitSurface
+
+
+def _check_area(model) -> None:
+    object.__setattr__(model, "mu", validation.positive_scalar("mu", model.mu))
+    object.__setattr__(model, "rho", validation.positive_scalar("rho", model.rho))
+    object.__setattr__(model, "tilt", finite_pair("tilt", model.tilt))
+    object.__setattr__(
+        model, "normal_force", validation.positive_scalar("normal_force", model.normal_force)
+    )
+
+
+def _tilt_text(tilt: tuple[float, float]) -> str:
+    return f"({fmt(tilt[0])}, {fmt(tilt[1])})"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, repr=False)
+class Cone(FrictionModel):
+    r"""Double cone with apexes at the maximum moment and base circle of radius ``max_force``.
+
+    In normalised coordinates (forces over ``mu N``, moment over ``mu rho N``)
+
+    .. math:: \|q_f - q_m t\| \le 1 - |q_m|,
+
+    the convex hull of the pure-translation circle and the two loads at maximum moment
+    ``±(t, 1)``; all of them lie on the exact limit surface, which is convex, so the cone lies
+    inside it: conservative for every contact (paper §4.2). ``t`` tilts the axis through the
+    load at maximum moment, as for :class:`~fixplan.models.Ellipsoid`. Any section through the
+    moment axis is the straight line ``|f|/max_force + |m|/max_moment = 1`` of the paper's
+    moment-force plots (:meth:`curve`).
+
+    Attributes
+    ----------
+    mu : float
+        Maximum friction force per unit normal force [-].
+    rho : float
+        Maximum moment over maximum force [m].
+    tilt : tuple of float
+        Force at maximum moment over the maximum force [-].
+    normal_force : float
+        Default normal force of the numeric methods [N].
+    """
+
+    mu: float
+    rho: float
+    tilt: tuple[float, float] = (0.0, 0.0)
+    normal_force: float = 1.0
+
+    conservative: ClassVar[bool] = True
+
+    def __post_init__(self):
+        _check_area(self)
+
+    @classmethod
+    def from_limit_surface(cls, ls: LimitSurface, *, tilted: bool = True) -> Cone:
+        """The cone of an exact limit surface (tilted through its load at maximum moment)."""
+        mu, rho, normal_force = surface_units(ls)
+        tilt = surface_tilt(ls) if tilted else (0.0, 0.0)
+        return cls(mu=mu, rho=rho, tilt=tilt, normal_force=normal_force)
+
+    @classmethod
+    def from_limits(
+        cls,
+        *,
+        max_force: float,
+        max_moment: float,
+        normal_force: float = 1.0,
+        apex_force: tuple[float, float] = (0.0, 0.0),
+    ) -> Cone:
+        """From maximum force [N] and moment [N m] at ``normal_force`` [N]; ``apex_force`` [N]
+        is the force of the load at maximum moment."""
+        max_force = validation.positive_scalar("max_force", max_force)
+        max_moment = validation.positive_scalar("max_moment", max_moment)
+        normal_force = validation.positive_scalar("normal_force", normal_force)
+        apex = finite_pair("apex_force", apex_force)
+        return cls(
+            mu=max_force / normal_force,
+            rho=max_moment / max_force,
+            tilt=(apex[0] / max_force, apex[1] / max_force),
+            normal_force=normal_force,
+        )
+
+    def _gauge(self, q):
+        t = self.tilt
+        fx = q[:, 0] - t[0] * q[:, 2]
+        fy = q[:, 1] - t[1] * q[:, 2]
+        return np.sqrt(fx * fx + fy * fy) + np.abs(q[:, 2])
+
+    def _unit_constraints(self, q, normal_force):
+        import cvxpy as cp
+
+        force = _shear(self.tilt)[:2] @ q
+        return [cp.norm(force, 2) + cp.abs(q[2]) <= normal_force]
+
+    def __repr__(self) -> str:
+        return (
+            f"Cone(mu={fmt(self.mu)}, rho={fmt(self.rho)} m, tilt={_tilt_text(self.tilt)}, "
+            f"normal_force={fmt(self.normal_force)} N)"
+        )
+
+
+def _apothem(facets: int, inscribed: bool) -> float:
+    """Distance of the facets from the centre of a regular polygon about the unit circle."""
+    return math.cos(math.pi / facets) if inscribed else 1.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, repr=False)
+class Pyramid(FrictionModel):
+    r"""Linear pyramid of the paper's eq. 11 and its generalisation to ``k`` facets.
+
+    The cone's circle is replaced by a regular ``k``-gon with facet normals
+    ``n_j = (cos 2πj/k, sin 2πj/k)``, inscribed in the circle (``c = cos(π/k)``, conservative)
+    or circumscribed about it (``c = 1``):
+
+    .. math:: n_j \cdot (q_f - q_m t) \le c\,(1 - |q_m|), \qquad j = 1 \dots k.
+
+    For ``k = 4`` inscribed and no tilt this is eq. 11 (Kerr and Roth):
+    ``|fx|, |fy| <= (mu N - |m|/lambda)/sqrt(2)``, whose bound ``|m| <= m_max`` the facets
+    imply. The ``2k`` linear inequalities (:meth:`inequalities`) suit LP and QP solvers such
+    as OSQP.
+
+    Attributes
+    ----------
+    mu, rho, tilt, normal_force
+        As for :class:`Cone`.
+    facets : int
+        Number of facets ``k >= 3`` of the force polygon.
+    inscribed : bool
+        Polygon inside the circle (conservative) or about it.
+    """
+
+    mu: float
+    rho: float
+    tilt: tuple[float, float] = (0.0, 0.0)
+    facets: int = 4
+    inscribed: bool = True
+    normal_force: float = 1.0
+    _rows: np.ndarray = field(init=False, compare=False)
+
+    def __post_init__(self):
+        _check_area(self)
+        object.__setattr__(self, "facets", facet_count(self.facets))
+        object.__setattr__(self, "inscribed", bool(self.inscribed))
+        normals = polygon_normals(self.facets) / _apothem(self.facets, self.inscribed)
+        slope = normals @ np.asarray(self.tilt)
+        rows = np.vstack(
+            [
+                np.column_stack([normals, 1.0 - slope]),
+                np.column_stack([normals, -1.0 - slope]),
+            ]
+        )
+        rows.setflags(write=False)
+        object.__setattr__(self, "_rows", rows)
+
+    @property
+    def conservative(self) -> bool:  # type: ignore[override]
+        """True for the inscribed pyramid (inside the cone, hence inside the surface)."""
+        return self.inscribed
+
+    @classmethod
+    def from_limit_surface(
+        cls, ls: LimitSurface, *, facets: int = 4, inscribed: bool = True, tilted: bool = True
+    ) -> Pyramid:
+        """The pyramid of an exact limit surface (tilted through its load at maximum moment)."""
+        mu, rho, normal_force = surface_units(ls)
+        tilt = surface_tilt(ls) if tilted else (0.0, 0.0)
+        return cls(
+            mu=mu,
+            rho=rho,
+            tilt=tilt,
+            facets=facets,
+            inscribed=inscribed,
+            normal_force=normal_force,
+        )
+
+    def inequalities(self, *, normal_force: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """``(A, b)`` with the pyramid ``{L : A @ L <= b}`` for loads ``L`` [N, N, N m].
+
+        ``A`` is ``(2k, 3)``, ``b`` ``(2k,)`` [N]; ``normal_force`` [N] defaults to the model's.
+        """
+        force = self.normal_force if normal_force is None else normal_force
+        force = validation.positive_scalar("normal_force", force)
+        return self._rows / self._units()[None, :], np.full(len(self._rows), force)
+
+    def _gauge(self, q):
+        return (q @ self._rows.T).max(axis=1)
+
+    def _unit_constraints(self, q, normal_force):
+        return [self._rows @ q <= normal_force]
+
+    def __repr__(self) -> str:
+        kind = "inscribed" if self.inscribed else "circumscribed"
+        return (
+            f"Pyramid(facets={self.facets}, {kind}, mu={fmt(self.mu)}, rho={fmt(self.rho)} m, "
+            f"tilt={_tilt_text(self.tilt)}, normal_force={fmt(self.normal_force)} N)"
+        )
+
+
+def _point_mu(ls: LimitSurface) -> tuple[float, float]:
+    mu, _, normal_force = surface_units(ls)
+    return mu, normal_force
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, repr=False)
+class PointCone(FrictionModel):
+    r"""Coulomb's friction cone of a point contact: ``‖(fx, fy)‖ <= mu N``, no torsion.
+
+    A second-order cone. It is the ``m = 0`` section of any limit surface with friction
+    ``mu``, hence conservative. Motion: the point slides along the applied force (maximum
+    dissipation), returned as a unit velocity.
+
+    Attributes
+    ----------
+    mu : float
+        Friction coefficient [-].
+    normal_force : float
+        Default normal force of the numeric methods [N].
+    """
+
+    mu: float
+    normal_force: float = 1.0
+
+    conservative: ClassVar[bool] = True
+    torsion: ClassVar[bool] = False
+
+    def __post_init__(self):
+        object.__setattr__(self, "mu", validation.positive_scalar("mu", self.mu))
+        object.__setattr__(
+            self, "normal_force", validation.positive_scalar("normal_force", self.normal_force)
+        )
+
+    @classmethod
+    def from_limit_surface(cls, ls: LimitSurface) -> PointCone:
+        """The cone of the surface's largest force (its torsional friction is dropped)."""
+        mu, normal_force = _point_mu(ls)
+        return cls(mu=mu, normal_force=normal_force)
+
+    def _gauge(self, q):
+        return np.hypot(q[:, 0], q[:, 1])
+
+    def _normal(self, q):
+        return q
+
+    def _unit_constraints(self, q, normal_force):
+        import cvxpy as cp
+
+        return [cp.SOC(normal_force, q)]
+
+    def __repr__(self) -> str:
+        return f"PointCone(mu={fmt(self.mu)}, normal_force={fmt(self.normal_force)} N)"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, repr=False)
+class PointPyramid(FrictionModel):
+    r"""Polygonal linearisation of the Coulomb cone, as used in simulators.
+
+    ``n_j · (fx, fy) <= c mu N`` for the ``k`` facet normals ``n_j = (cos 2πj/k, sin 2πj/k)``,
+    with ``c = cos(π/k)`` for the polygon inscribed in the circle (conservative) and ``c = 1``
+    circumscribed about it. No torsion, no motion map.
+
+    Attributes
+    ----------
+    mu, normal_force
+        As for :class:`PointCone`.
+    facets : int
+        Number of facets ``k >= 3``.
+    inscribed : bool
+        Polygon inside the circle (conservative) or about it.
+    """
+
+    mu: float
+    facets: int = 4
+    inscribed: bool = True
+    normal_force: float = 1.0
+    _rows: np.ndarray = field(init=False, compare=False)
+
+    torsion: ClassVar[bool] = False
+
+    def __post_init__(self):
+        object.__setattr__(self, "mu", validation.positive_scalar("mu", self.mu))
+        object.__setattr__(
+            self, "normal_force", validation.positive_scalar("normal_force", self.normal_force)
+        )
+        object.__setattr__(self, "facets", facet_count(self.facets))
+        object.__setattr__(self, "inscribed", bool(self.inscribed))
+        rows = polygon_normals(self.facets) / _apothem(self.facets, self.inscribed)
+        rows.setflags(write=False)
+        object.__setattr__(self, "_rows", rows)
+
+    @property
+    def conservative(self) -> bool:  # type: ignore[override]
+        """True for the inscribed pyramid."""
+        return self.inscribed
+
+    @classmethod
+    def from_limit_surface(
+        cls, ls: LimitSurface, *, facets: int = 4, inscribed: bool = True
+    ) -> PointPyramid:
+        """The pyramid of the surface's largest force (its torsional friction is dropped)."""
+        mu, normal_force = _point_mu(ls)
+        return cls(mu=mu, facets=facets, inscribed=inscribed, normal_force=normal_force)
+
+    def inequalities(self, *, normal_force: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """``(A, b)`` with the pyramid ``{f : A @ f <= b}`` for forces ``(fx, fy)`` [N]."""
+        force = self.normal_force if normal_force is None else normal_force
+        force = validation.positive_scalar("normal_force", force)
+        return self._rows / self.mu, np.full(len(self._rows), force)
+
+    def _gauge(self, q):
+        return (q @ self._rows.T).max(axis=1)
+
+    def _unit_constraints(self, q, normal_force):
+        return [self._rows @ q <= normal_force]
+
+    def __repr__(self) -> str:
+        kind = "inscribed" if self.inscribed else "circumscribed"
+        return (
+            f"PointPyramid(facets={self.facets}, {kind}, mu={fmt(self.mu)}, "
+            f"normal_force={fmt(self.normal_force)} N)"
+        )
