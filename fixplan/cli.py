@@ -1,34 +1,53 @@
 """The ``fixplan`` command line.
 
-Results go to stdout, messages to stderr. Exit codes: 0 success, 1 unexpected error,
-2 invalid input.
+Results go to stdout; logs, warnings and progress to stderr (a progress bar only on a terminal).
+Exit codes: 0 success, 1 unexpected error, 2 invalid input, 3 cannot be held (infeasible, or a
+load case whose safety factor is below 1), 4 solver failure or inaccurate result.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import logging
 import sys
+import time
+import warnings
 from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
 
 from fixplan import __version__, pressure
-from fixplan.errors import FixplanError
-from fixplan.limit_surface import LimitSurface
+from fixplan.errors import FixplanError, InvalidArgumentError
+from fixplan.problem import MODEL_NAMES
 
 EXIT_OK = 0
 EXIT_UNEXPECTED = 1
 EXIT_INVALID_INPUT = 2
+EXIT_NOT_HELD = 3
+EXIT_SOLVER = 4
 
-_DESCRIPTION = """\
-example:
-  fixplan surface --shape rectangle --length 0.08 --width 0.008 --mu 0.3 --normal-force 500
-
-Grasp and fixture planning with friction limit surfaces (Howe & Cutkosky).
-
-exit codes: 0 success, 1 unexpected error, 2 invalid input
+EXIT_CODES = f"""\
+exit codes:
+  {EXIT_OK}  success
+  {EXIT_UNEXPECTED}  unexpected error
+  {EXIT_INVALID_INPUT}  invalid input (bad file, option or value)
+  {EXIT_NOT_HELD}  cannot be held (infeasible, or a load case with safety factor < 1)
+  {EXIT_SOLVER}  solver failure or inaccurate result
 """
+
+_DESCRIPTION = f"""\
+example:
+  fixplan plan problems/vise-milling.toml
+
+Grasp and fixture planning with friction limit surfaces (after Howe & Cutkosky, "Practical
+Force-Motion Models for Sliding Manipulation"): the smallest clamp or grip forces that hold a
+part under every task load, the safety margin of a given setup, and how it would start to slide.
+
+{EXIT_CODES}"""
+
+log = logging.getLogger("fixplan")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -39,6 +58,15 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_INVALID_INPUT, f"{self.prog}: error: {message}\n")
 
 
+def _subcommand(commands, name: str, help_text: str, example: str):
+    return commands.add_parser(
+        name,
+        help=help_text,
+        description=f"example:\n  {example}\n\n{help_text}\n\n{EXIT_CODES}",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+
+
 def _build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="fixplan",
@@ -47,13 +75,31 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"fixplan {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    surface = commands.add_parser(
-        "surface",
-        help="the limit surface of one contact patch",
-        description="Summarise the exact limit surface of one contact patch.\n\nexample:\n"
-        "  fixplan surface --shape disk --radius 0.01 --pressure hertz --mu 0.8 --normal-force 20",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+
+    plan = _subcommand(
+        commands, "plan", "solve a problem file and summarise the plan",
+        "fixplan plan problems/vise-milling.toml --report out/",
+    )  # fmt: skip
+    plan.add_argument("file", type=Path, help="problem file (TOML)")
+    plan.add_argument("--json", action="store_true", help="print one JSON document")
+    plan.add_argument("--report", type=Path, metavar="DIR", help="write a report folder")
+    plan.add_argument("--model", choices=MODEL_NAMES, help="override every contact's model")
+    plan.add_argument("--solver", choices=("CLARABEL", "OSQP", "SCS"), help="conic/QP solver")
+    _verbosity(plan)
+    plan.set_defaults(run=_run_plan)
+
+    check = _subcommand(
+        commands, "check", "validate a problem file and report every problem in it",
+        "fixplan check problems/fixture-321.toml",
+    )  # fmt: skip
+    check.add_argument("file", type=Path, help="problem file (TOML)")
+    _verbosity(check)
+    check.set_defaults(run=_run_check)
+
+    surface = _subcommand(
+        commands, "surface", "the limit surface of one contact patch and every model's error",
+        "fixplan surface --shape disk --radius 0.01 --pressure hertz --mu 0.8 --normal-force 20",
+    )  # fmt: skip
     surface.add_argument("--shape", choices=("disk", "rectangle"), required=True)
     surface.add_argument("--radius", type=float, help="disk radius [m]")
     surface.add_argument("--inner-radius", type=float, help="annulus inner radius [m]")
@@ -64,27 +110,194 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     surface.add_argument("--mu", type=float, required=True, help="friction coefficient")
     surface.add_argument("--normal-force", type=float, default=1.0, help="normal force [N]")
+    surface.add_argument("--plot", type=Path, metavar="PNG", help="save the cross sections")
     surface.add_argument("--json", action="store_true", help="print one JSON document")
+    _verbosity(surface)
     surface.set_defaults(run=_run_surface)
+
+    compare = _subcommand(
+        commands, "compare", "solve a problem with every applicable model, side by side",
+        "fixplan compare problems/hertz-pinch.toml",
+    )  # fmt: skip
+    compare.add_argument("file", type=Path, help="problem file (TOML)")
+    compare.add_argument("--json", action="store_true", help="print one JSON document")
+    compare.add_argument("--solver", choices=("CLARABEL", "OSQP", "SCS"), help="solver")
+    _verbosity(compare)
+    compare.set_defaults(run=_run_compare)
     return parser
+
+
+def _verbosity(parser: argparse.ArgumentParser) -> None:
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument("-q", "--quiet", action="store_true", help="errors only on stderr")
+    group.add_argument("-v", "--verbose", action="store_true", help="more detail on stderr")
+
+
+class _Progress:
+    """A progress bar on stderr, drawn only when stderr is a terminal."""
+
+    def __init__(self, label: str, enabled: bool):
+        self.label = label
+        self.enabled = enabled and sys.stderr.isatty()
+        self.start = time.perf_counter()
+
+    def __call__(self, done: int, total: int) -> None:
+        if not self.enabled or time.perf_counter() - self.start < 0.5:
+            return
+        width = 30
+        filled = int(width * done / max(total, 1))
+        bar = "#" * filled + "-" * (width - filled)
+        sys.stderr.write(f"\r{self.label} [{bar}] {done}/{total}")
+        if done >= total:
+            sys.stderr.write("\n")
+        sys.stderr.flush()
+
+
+# -- plan ----------------------------------------------------------------------------------------
+
+
+def _exit_code(plan) -> int:
+    if plan.status == "infeasible":
+        return EXIT_NOT_HELD
+    if plan.status != "optimal":
+        return EXIT_SOLVER
+    if plan.held and not all(plan.held.values()):
+        return EXIT_NOT_HELD
+    return EXIT_OK
+
+
+def _number(value: float, unit: str = "") -> str:
+    if value is None:
+        return "-"
+    if not np.isfinite(value):
+        return "inf" if value > 0 else str(value)
+    return f"{value:.4g}{(' ' + unit) if unit else ''}"
+
+
+def _summary(problem_file, plan) -> str:
+    problem = problem_file.problem
+    lines = [
+        f"problem    {problem_file.name} ({problem_file.kind}), {len(problem.contacts)} contacts, "
+        f"{len(problem.loads)} load cases",
+        f"objective  {plan.objective}",
+        f"status     {plan.status}",
+    ]
+    if plan.objective_value is not None:
+        unit = "" if plan.objective in ("max-safety-factor", "check") else "N"
+        if plan.objective == "min-squared-normal-force":
+            unit = "N^2"
+        lines.append(f"value      {_number(plan.objective_value, unit)}")
+    if plan.forces:
+        lines.append("active forces")
+        for name, force in plan.forces.items():
+            if np.ndim(force) == 0:
+                lines.append(f"  {name:24s} {_number(force, 'N'):>12s}  (clamp)")
+            else:
+                lines.append(
+                    f"  {name:24s} {_number(float(np.max(force)), 'N'):>12s}  (finger, largest "
+                    "over the load cases)"
+                )
+    if plan.safety_factors:
+        lines.append("safety factors (multiple of each task load still held)")
+        for name, value in plan.safety_factors.items():
+            mark = "held" if plan.held.get(name) else "NOT HELD"
+            critical = "  <- critical" if name == plan.critical_load else ""
+            lines.append(f"  {name:24s} {_number(value):>12s}  {mark}{critical}")
+    if plan.critical_load is not None:
+        lines.append(f"critical   load {plan.critical_load!r}, contact {plan.critical_contact!r}")
+        motion = plan.motions.get(plan.critical_load)
+        if motion is not None:
+            lines.append(f"motion     if it slips, the part {motion.describe()}")
+    if plan.certificate:
+        lines.append(f"cannot be held: {plan.certificate}")
+    for note in plan.warnings:
+        lines.append(f"warning    {note}")
+    return "\n".join(lines)
+
+
+def _load(file: Path, model: str | None = None):
+    from fixplan.problem_file import load_problem
+
+    return load_problem(file, model=model)
+
+
+def _run_plan(args: argparse.Namespace) -> int:
+    from fixplan.planner import Planner
+
+    problem_file = _load(args.file, args.model)
+    planner = Planner(problem_file.problem, solver=args.solver)
+    log.info("solving %s (%d load cases)", args.file, len(problem_file.problem.loads))
+    plan = planner.solve(progress=_Progress("solving", not args.quiet))
+    if args.report is not None:
+        from fixplan.report import write_report
+
+        written = write_report(args.report, problem_file, plan, planner)
+        log.info("wrote %d report files to %s", len(written), args.report)
+    if args.json:
+        document = plan.as_dict()
+        document["problem"] = {"name": problem_file.name, "file": str(problem_file.path),
+                               "sha256": problem_file.sha256}  # fmt: skip
+        print(json.dumps(document, indent=2, sort_keys=True))
+    else:
+        print(_summary(problem_file, plan))
+    return _exit_code(plan)
+
+
+# -- check ---------------------------------------------------------------------------------------
+
+
+def _run_check(args: argparse.Namespace) -> int:
+    problem_file = _load(args.file)
+    problem = problem_file.problem
+    print(
+        f"{args.file}: valid — {problem_file.name} ({problem_file.kind}), objective "
+        f"{problem.objective}, {len(problem.contacts)} contacts, {len(problem.loads)} load cases"
+    )
+    return EXIT_OK
+
+
+# -- surface -------------------------------------------------------------------------------------
 
 
 def _patch(args: argparse.Namespace) -> pressure.PressureField:
     if args.shape == "disk":
         if args.radius is None:
-            raise FixplanError("--shape disk needs --radius (m)")
+            raise InvalidArgumentError("--shape disk needs --radius [m]")
         inner = args.inner_radius if args.pressure == "annulus" else None
         return pressure.disk(args.radius, args.pressure, inner_radius=inner)
     if args.length is None or args.width is None:
-        raise FixplanError("--shape rectangle needs --length and --width (m)")
+        raise InvalidArgumentError("--shape rectangle needs --length and --width [m]")
     if args.pressure != "uniform":
-        raise FixplanError("--shape rectangle supports only --pressure uniform")
+        raise InvalidArgumentError("--shape rectangle supports only --pressure uniform")
     return pressure.rectangle(args.length, args.width)
 
 
+def _surface_models(surface):
+    from fixplan.models import Cone, Ellipsoid, Exact, FittedEllipsoid, PointCone, Pyramid
+
+    return {
+        "ellipsoid": Ellipsoid.from_limit_surface(surface),
+        "fitted-ellipsoid": FittedEllipsoid.from_limit_surface(surface),
+        "cone": Cone.from_limit_surface(surface),
+        "pyramid (4, inscribed)": Pyramid.from_limit_surface(surface),
+        "pyramid (8, inscribed)": Pyramid.from_limit_surface(surface, facets=8),
+        "exact (128 disks)": Exact.from_limit_surface(surface),
+        "point-cone": PointCone.from_limit_surface(surface),
+    }
+
+
 def _run_surface(args: argparse.Namespace) -> int:
+    from fixplan.compare import compare
+    from fixplan.limit_surface import LimitSurface
+
     surface = LimitSurface(_patch(args), mu=args.mu, normal_force=args.normal_force)
-    section = surface.curve("fy-m", 9)
+    models = _surface_models(surface)
+    accuracy = {name: compare(model, surface, n=1000) for name, model in models.items()}
+    if args.plot is not None:
+        from fixplan.figures import save_png, surface_figure
+
+        save_png(surface_figure(surface, models), args.plot)
+        log.info("wrote %s", args.plot)
     summary = {
         "shape": args.shape,
         "pressure": args.pressure,
@@ -93,32 +306,106 @@ def _run_surface(args: argparse.Namespace) -> int:
         "max_force_N": surface.max_force,
         "max_moment_Nm": surface.max_moment,
         "characteristic_length_m": surface.characteristic_length,
-        "limit_curve_fy_m": [[float(f), float(m)] for _, f, m in section[:3]],
+        "models": {
+            name: {
+                "max_overestimate": acc.max_overestimate,
+                "max_underestimate": acc.max_underestimate,
+                "unsafe_fraction": acc.unsafe_fraction,
+                "max_motion_angle_rad": acc.max_motion_angle,
+            }
+            for name, acc in accuracy.items()
+        },
     }
     if args.json:
-        print(json.dumps(summary, indent=2))
+        print(json.dumps(summary, indent=2, sort_keys=True))
         return EXIT_OK
     print(f"limit surface of a {args.shape} patch ({args.pressure} pressure)")
     print(f"  mu = {args.mu:g}, normal force = {args.normal_force:g} N")
-    print(f"  max friction force   {surface.max_force:12.6g} N")
-    print(f"  max friction moment  {surface.max_moment:12.6g} N m")
-    print(f"  characteristic length {surface.characteristic_length:11.6g} m")
-    print("  limit curve (fy, m) from pure force to pure moment:")
-    for _, f, m in section[:3]:
-        print(f"    fy = {f:12.6g} N    m = {m:12.6g} N m")
+    print(f"  max friction force     {surface.max_force:12.6g} N")
+    print(f"  max friction moment    {surface.max_moment:12.6g} N m")
+    print(f"  characteristic length  {surface.characteristic_length:12.6g} m")
+    print("model errors against the exact surface (radial, over 1000 load directions;")
+    print("  over = model holds more than the contact: unsafe)")
+    print(f"  {'model':24s} {'max over':>9s} {'max under':>10s} {'unsafe':>7s} {'motion':>9s}")
+    for name, acc in accuracy.items():
+        angle = "-" if acc.max_motion_angle is None else f"{np.degrees(acc.max_motion_angle):.2f}°"
+        print(
+            f"  {name:24s} {100 * acc.max_overestimate:8.2f}% {100 * acc.max_underestimate:9.2f}%"
+            f" {100 * acc.unsafe_fraction:6.1f}% {angle:>9s}"
+        )
     return EXIT_OK
+
+
+# -- compare -------------------------------------------------------------------------------------
+
+
+def _compare_models(problem) -> list[str]:
+    point_models = ["point-cone", "point-pyramid"]
+    if all(contact.patch is not None for contact in problem.contacts):
+        return ["exact", "ellipsoid", "cone", "pyramid", *point_models]
+    return point_models
+
+
+def _run_compare(args: argparse.Namespace) -> int:
+    from fixplan.planner import Planner
+
+    base = _load(args.file)
+    models = _compare_models(base.problem)
+    progress = _Progress("models", not args.quiet)
+    rows = []
+    for index, model in enumerate(models):
+        problem_file = _load(args.file, model)
+        start = time.perf_counter()
+        plan = Planner(problem_file.problem, solver=args.solver).solve()
+        elapsed = time.perf_counter() - start
+        rows.append((model, plan, elapsed))
+        progress(index + 1, len(models))
+    if args.json:
+        document = {
+            model: {
+                "status": plan.status,
+                "objective_value": plan.as_dict()["objective_value"],
+                "safety_factor": plan.as_dict()["safety_factor"],
+                "safety_factors": plan.as_dict()["safety_factors"],
+                "solve_time_s": elapsed,
+            }
+            for model, plan, elapsed in rows
+        }
+        print(json.dumps(document, indent=2, sort_keys=True))
+    else:
+        print(f"{base.name}: objective {base.problem.objective}, every contact with one model")
+        print(f"  {'model':14s} {'status':11s} {'value':>12s} {'min safety':>11s} {'time':>8s}")
+        for model, plan, elapsed in rows:
+            print(
+                f"  {model:14s} {plan.status:11s} {_number(plan.objective_value):>12s} "
+                f"{_number(plan.safety_factor):>11s} {elapsed:7.2f}s"
+            )
+    return max(_exit_code(plan) for _, plan, _ in rows)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
     parser = _build_parser()
     args = parser.parse_args(argv)
+    level = logging.ERROR if args.quiet else logging.DEBUG if args.verbose else logging.WARNING
+    logging.basicConfig(level=level, format="fixplan: %(message)s", stream=sys.stderr)
     try:
-        with np.errstate(all="ignore"):
-            return args.run(args)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore" if args.quiet else "default")
+            with np.errstate(all="ignore"):
+                return args.run(args)
     except FixplanError as exc:
         print(f"fixplan: error: {exc}", file=sys.stderr)
         return EXIT_INVALID_INPUT
+    except KeyboardInterrupt:  # pragma: no cover
+        return EXIT_UNEXPECTED
+    except Exception as exc:  # noqa: BLE001 - last resort: say what happened, never a traceback
+        log.debug("unexpected error", exc_info=True)
+        print(
+            f"fixplan: unexpected error: {type(exc).__name__}: {exc} (run with -v for details)",
+            file=sys.stderr,
+        )
+        return EXIT_UNEXPECTED
 
 
 if __name__ == "__main__":  # pragma: no cover

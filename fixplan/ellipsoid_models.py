@@ -263,7 +263,16 @@ class FittedEllipsoid(FrictionModel):
         )
 
     def _gauge(self, q):
-        return np.linalg.norm(q @ self._factor.T, axis=1)
+        m = self.matrix
+        x, y, z = q[:, 0], q[:, 1], q[:, 2]
+        # q^T M q written out: thin matrix products are slow in BLAS.
+        form = (
+            m[0, 0] * x * x
+            + m[1, 1] * y * y
+            + m[2, 2] * z * z
+            + 2.0 * (m[0, 1] * x * y + m[0, 2] * x * z + m[1, 2] * y * z)
+        )
+        return np.sqrt(np.maximum(form, 0.0))
 
     def _normal(self, q):
         return q @ self.matrix
@@ -404,7 +413,7 @@ class FacetedEllipsoid(FrictionModel):
 
     def _pieces(self, q):
         """Gauges of the ellipsoid ``(K,)`` and of the facet pairs ``(K, P)``."""
-        return self.ellipsoid._gauge(q), np.abs(q @ self._planes.T)
+        return self.ellipsoid._gauge(q), np.abs(np.einsum("ij,kj->ik", q, self._planes))
 
     def _gauge(self, q):
         ellipsoid, facets = self._pieces(q)

@@ -380,7 +380,7 @@ def _parse_region(index: int, region: object) -> tuple[int, np.ndarray | float, 
             f"{name} must be a tuple (kind, geometry, weight), got {region!r}"
         )
     kind = validation.choice(f"{name} kind", region[0], REGION_KINDS)
-    weight = validation.nonnegative_scalar(f"{name} weight", region[2])
+    weight = validation.finite_scalar(f"{name} weight", region[2])
     if kind == "polygon":
         vertices = validation.finite_array(f"{name} vertices", region[1], shape=(None, 2))
         return _POLYGON, simple_polygon(name, vertices), weight
@@ -442,8 +442,9 @@ class FunctionKernel(SupportKernel):
         Regions in the local frame [m], each ``("polygon", vertices, weight)`` (vertices
         ``(n, 2)`` of a simple polygon), ``("disk", radius, weight)`` or
         ``("circle", radius, weight)`` (a line density on the circle, ``dA`` replaced by arc
-        length); disks and circles are centred at the origin. ``weight`` (>= 0) multiplies
-        ``p`` on that region, e.g. the measured pressure of a tactile cell.
+        length); disks and circles are centred at the origin. ``weight`` multiplies
+        ``p`` on that region, e.g. the measured pressure of a tactile cell; it may be negative (an
+        annulus is a disk minus a smaller disk).
     pressure : callable or None
         ``p(x, y)`` for arrays ``x, y`` [m] of equal shape, smooth, >= 0 on the patch; ``None``
         for ``p = 1``. On polygons it is also evaluated (and must be smooth) on the triangles
@@ -478,7 +479,7 @@ class FunctionKernel(SupportKernel):
             float(np.max(np.hypot(*geometry.T))) if kind == _POLYGON else geometry
             for kind, geometry, _ in parsed
         )
-        parsed = [region for region in parsed if region[2] > 0.0]
+        parsed = [region for region in parsed if region[2] != 0.0]
         if not parsed:
             raise InvalidArgumentError("every region has weight 0: the patch carries no load")
         kinds = np.array([kind for kind, _, _ in parsed])

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import time
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import cvxpy as cp
@@ -192,12 +192,19 @@ class Planner:
 
     # -- solving ------------------------------------------------------------------------------
 
-    def solve(self, loads: Sequence[Load] | None = None, *, analyse: bool = True) -> Plan:
+    def solve(
+        self,
+        loads: Sequence[Load] | None = None,
+        *,
+        analyse: bool = True,
+        progress: Callable[[int, int], None] | None = None,
+    ) -> Plan:
         """Solve with ``loads`` (default: the problem's); the structure is reused.
 
         ``loads`` must have the problem's number of load cases. With ``analyse`` (default) a
         force objective is followed by the fixed-force analysis of the forces found (safety
-        factors, impending motions, utilisation).
+        factors, impending motions, utilisation). ``progress(done, total)`` is called as load
+        cases are solved (the fixed-force objectives solve them in blocks).
         """
         loads = self.problem.loads if loads is None else tuple(loads)
         if len(loads) != len(self.problem.loads) or not all(isinstance(x, Load) for x in loads):
@@ -210,7 +217,7 @@ class Planner:
         fixed_values = {
             i: c.force for i, c in enumerate(self.problem.contacts) if c.force is not None
         }
-        result = self._run(objective, wrenches, fixed_values)
+        result = self._run(objective, wrenches, fixed_values, progress)
         plan_kwargs = {"load_names": tuple(x.name for x in loads)}
         status, solver = result["status"], result["solver"]
         notes = list(result["warnings"])
@@ -233,7 +240,7 @@ class Planner:
         analysis = result
         if objective not in FIXED_FORCE_OBJECTIVES and analyse and status == "optimal":
             fixed = {i: (f if np.ndim(f) == 0 else np.asarray(f)) for i, f in self._indexed(forces)}
-            analysis = self._run("check", wrenches, fixed)
+            analysis = self._run("check", wrenches, fixed, progress)
             if analysis["status"] not in ("optimal", "inaccurate"):
                 notes.append(f"safety analysis of the forces found: {analysis['status']}")
                 analysis = None
@@ -264,7 +271,7 @@ class Planner:
             **fields,
         )
 
-    def _run(self, objective: str, wrenches: np.ndarray, fixed_values: dict) -> dict:
+    def _run(self, objective: str, wrenches: np.ndarray, fixed_values: dict, progress=None) -> dict:
         """Solve all load cases, block by block for the fixed-force objectives.
 
         Their load cases are independent (the active forces are given), so a problem compiled
@@ -283,6 +290,8 @@ class Planner:
             }
             result = self._run_block(objective, wrenches[:, padded], fixed)
             results.append((result, len(index)))
+            if progress is not None:
+                progress(int(index[-1]) + 1, cases)
         return _merge(results)
 
     def _run_block(self, objective: str, wrenches: np.ndarray, fixed_values: dict) -> dict:
