@@ -72,7 +72,9 @@ def socp_safety(points, friction, load):
 
     forces = cp.Variable((len(points), 2))
     scale = cp.Variable()
-    moment = cp.sum(cp.multiply(points[:, 0], forces[:, 1]) - cp.multiply(points[:, 1], forces[:, 0]))
+    moment = cp.sum(
+        cp.multiply(points[:, 0], forces[:, 1]) - cp.multiply(points[:, 1], forces[:, 0])
+    )
     balance = [cp.sum(forces[:, 0]) == scale * load[0], cp.sum(forces[:, 1]) == scale * load[1]]
     balance.append(moment == scale * load[2])
     cones = [cp.norm(forces, 2, axis=1) <= friction]

@@ -76,12 +76,18 @@ def main() -> None:
     print("planner, 8-contact x 20-load fixture, objective min-total-clamp-force")
     ellipsoid = build_and_resolve("ellipsoid")
     exact = build_and_resolve("exact")
-    print(f"  ellipsoid: build + first solve {ellipsoid[0]:7.3f} s, median re-solve "
-          f"{ellipsoid[1] * 1e3:7.2f} ms, total clamp force {ellipsoid[2]:8.2f} N")
-    print(f"  exact:     build + first solve {exact[0]:7.3f} s, median re-solve "
-          f"{exact[1] * 1e3:7.2f} ms, total clamp force {exact[2]:8.2f} N")
-    print(f"  exact / ellipsoid cost: build x{exact[0] / ellipsoid[0]:.1f}, "
-          f"re-solve x{exact[1] / ellipsoid[1]:.1f}")
+    print(
+        f"  ellipsoid: build + first solve {ellipsoid[0]:7.3f} s, median re-solve "
+        f"{ellipsoid[1] * 1e3:7.2f} ms, total clamp force {ellipsoid[2]:8.2f} N"
+    )
+    print(
+        f"  exact:     build + first solve {exact[0]:7.3f} s, median re-solve "
+        f"{exact[1] * 1e3:7.2f} ms, total clamp force {exact[2]:8.2f} N"
+    )
+    print(
+        f"  exact / ellipsoid cost: build x{exact[0] / ellipsoid[0]:.1f}, "
+        f"re-solve x{exact[1] / ellipsoid[1]:.1f}"
+    )
 
     problem = fixture("ellipsoid", "min-total-clamp-force", milling_loads(20, 0))
     planner = Planner(problem)
@@ -90,8 +96,10 @@ def main() -> None:
     raw = []
     for _ in range(20):
         raw.append(timed(lambda: compiled.solve(solver=cp.CLARABEL))[1])
-    print(f"  baseline: cvxpy + Clarabel alone on the compiled problem {np.median(raw) * 1e3:.2f} ms"
-          f" (fixplan's re-solve adds verification: x{ellipsoid[1] / np.median(raw):.2f})")
+    print(
+        f"  baseline: cvxpy + Clarabel alone on the compiled problem {np.median(raw) * 1e3:.2f} ms"
+        f" (fixplan's re-solve adds verification: x{ellipsoid[1] / np.median(raw):.2f})"
+    )
 
     loads = milling_loads(1000, 7)
     check = fixture("ellipsoid", "check", loads, clamp_force=2000.0)
@@ -99,9 +107,11 @@ def main() -> None:
     plan, first = timed(check_planner.solve)
     plan, again = timed(check_planner.solve)
     held = sum(plan.held.values())
-    print(f"check of 1,000 load cases: {1000 / again:7.0f} cases/s ({again:.2f} s; first call "
-          f"{first:.2f} s with compilation); {held} held, smallest safety factor "
-          f"{plan.safety_factor:.3f}")
+    print(
+        f"check of 1,000 load cases: {1000 / again:7.0f} cases/s ({again:.2f} s; first call "
+        f"{first:.2f} s with compilation); {held} held, smallest safety factor "
+        f"{plan.safety_factor:.3f}"
+    )
 
 
 if __name__ == "__main__":

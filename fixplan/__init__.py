@@ -7,7 +7,7 @@ exact limit surfaces of planar contacts for any pressure distribution (:class:`L
 
 from importlib.metadata import PackageNotFoundError, version
 
-from fixplan import pressure
+from fixplan import compare, models, pressure
 from fixplan.errors import (
     ConvergenceError,
     FixplanError,
@@ -30,5 +30,7 @@ __all__ = [
     "LimitSurface",
     "ModelError",
     "__version__",
+    "compare",
+    "models",
     "pressure",
 ]

@@ -399,7 +399,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_INVALID_INPUT
     except KeyboardInterrupt:  # pragma: no cover
         return EXIT_UNEXPECTED
-    except Exception as exc:  # noqa: BLE001 - last resort: say what happened, never a traceback
+    except Exception as exc:
         log.debug("unexpected error", exc_info=True)
         print(
             f"fixplan: unexpected error: {type(exc).__name__}: {exc} (run with -v for details)",

@@ -25,7 +25,7 @@ from fixplan.problem import Contact
 from fixplan.sphere import circle, fibonacci_sphere
 
 COMPONENTS = ("fx", "fy", "fz", "mx", "my", "mz")
-_OPTIONS = {"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10, "tol_feas": 1e-10}
+_OPTIONS = {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9}
 
 
 class ContactSetSurface:
@@ -154,9 +154,11 @@ class ContactSetSurface:
 
     def curve(self, axes: tuple[str, str], n: int = 120) -> np.ndarray:
         """Cross section ``(n, 2)`` by the plane of two subspace components ``axes``."""
-        index = [self.subspace.index(a) for a in axes] if all(
-            a in self.subspace for a in axes
-        ) else None
+        index = (
+            [self.subspace.index(a) for a in axes]
+            if all(a in self.subspace for a in axes)
+            else None
+        )
         if index is None or len(set(index)) != 2:
             raise InvalidArgumentError(f"axes must be two of {self.subspace}, got {axes}")
         points = []

@@ -16,6 +16,7 @@ import numpy as np
 from fixplan import validation
 from fixplan.errors import ConvergenceError, InvalidArgumentError
 from fixplan.model_base import FrictionModel, finite_pair, fmt
+from fixplan.sphere import fibonacci_sphere
 from fixplan.tolerances import FIT_MIN_EIGENVALUE, TILT_ATOL
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -38,14 +39,89 @@ def surface_units(ls: LimitSurface) -> tuple[float, float, float]:
     return ls.max_force / ls.normal_force, ls.characteristic_length, ls.normal_force
 
 
-def surface_tilt(ls: LimitSurface) -> tuple[float, float]:
-    """Force ``(fx0, fy0)`` of the load at maximum moment, over ``max_force`` (Table 2, step 2).
+def surface_axis(ls: LimitSurface) -> tuple[tuple[float, float], float, tuple[float, float]]:
+    """Centre of pressure, characteristic length and tilt of a surface (Table 2, steps 1-2).
 
-    Components below ``TILT_ATOL`` are rounding noise of a symmetric field and are set to 0.
+    Returns
+    -------
+    center : tuple of float
+        Friction-weighted centre of pressure ``c`` [m] (paper eq. 2), read off the loads of
+        pure translation, whose moments are ``c × f``.
+    rho : float
+        Largest moment about ``c`` (rotation about ``c``) over the largest force [m].
+    tilt : tuple of float
+        Force ``(fx0, fy0)`` of the load at that largest moment, over ``max_force`` [-].
+
+    Components below ``TILT_ATOL`` (of ``rho`` for the centre) are rounding noise of a
+    symmetric field and are set to 0.
     """
-    force = ls.load_at_cor((0.0, 0.0))[:2] / ls.max_force
-    force = np.where(np.abs(force) < TILT_ATOL, 0.0, force)
-    return float(force[0]), float(force[1])
+    max_force, length = ls.max_force, ls.characteristic_length
+    along_x, along_y = ls.load(np.eye(3)[:2])
+    center = np.array([along_y[2], -along_x[2]]) / max_force
+    center = np.where(np.abs(center) < TILT_ATOL * length, 0.0, center)
+    rotation = np.array([center[1], -center[0], 1.0])
+    apex = ls.load(rotation)
+    tilt = apex[:2] / max_force
+    tilt = np.where(np.abs(tilt) < TILT_ATOL, 0.0, tilt)
+    rho = float(ls.support(rotation)) / max_force
+    return (float(center[0]), float(center[1])), rho, (float(tilt[0]), float(tilt[1]))
+
+
+def area_parameters(ls: LimitSurface, tilted: bool) -> dict:
+    """Keyword arguments ``mu, rho, tilt, center, normal_force`` of an area model of ``ls``."""
+    mu, _, normal_force = surface_units(ls)
+    center, rho, tilt = surface_axis(ls)
+    return {
+        "mu": mu,
+        "rho": rho,
+        "tilt": tilt if tilted else (0.0, 0.0),
+        "center": center,
+        "normal_force": normal_force,
+    }
+
+
+def limit_parameters(
+    max_force: float,
+    max_moment: float,
+    normal_force: float,
+    apex_force: tuple[float, float],
+    center: tuple[float, float],
+) -> dict:
+    """Keyword arguments of an area model from its largest force [N] and moment [N m]."""
+    max_force = validation.positive_scalar("max_force", max_force)
+    max_moment = validation.positive_scalar("max_moment", max_moment)
+    normal_force = validation.positive_scalar("normal_force", normal_force)
+    apex = finite_pair("apex_force", apex_force)
+    return {
+        "mu": max_force / normal_force,
+        "rho": max_moment / max_force,
+        "tilt": (apex[0] / max_force, apex[1] / max_force),
+        "center": finite_pair("center", center),
+        "normal_force": normal_force,
+    }
+
+
+def check_area(model) -> None:
+    """Validate and normalise the fields ``mu, rho, tilt, center, normal_force`` of ``model``."""
+    object.__setattr__(model, "mu", validation.positive_scalar("mu", model.mu))
+    object.__setattr__(model, "rho", validation.positive_scalar("rho", model.rho))
+    object.__setattr__(model, "tilt", finite_pair("tilt", model.tilt))
+    object.__setattr__(model, "center", finite_pair("center", model.center))
+    object.__setattr__(
+        model, "normal_force", validation.positive_scalar("normal_force", model.normal_force)
+    )
+
+
+def area_repr(model, extra: str = "") -> str:
+    """``Name(extra mu=..., rho=... m, tilt=(..), [center=(..) m, ]normal_force=... N)``."""
+    tilt = f"({fmt(model.tilt[0])}, {fmt(model.tilt[1])})"
+    center = ""
+    if model.center != (0.0, 0.0):
+        center = f"center=({fmt(model.center[0])}, {fmt(model.center[1])}) m, "
+    return (
+        f"{type(model).__name__}({extra}mu={fmt(model.mu)}, rho={fmt(model.rho)} m, "
+        f"tilt={tilt}, {center}normal_force={fmt(model.normal_force)} N)"
+    )
 
 
 def _shear(tilt: tuple[float, float]) -> np.ndarray:
@@ -69,7 +145,8 @@ class Ellipsoid(FrictionModel):
 
     which keeps both exact features of the limit surface: the circle of pure translation at
     ``m = 0`` and the load at maximum moment, where the tangent plane stays horizontal as on
-    the exact surface. Motion is the ellipsoid normal (step 5).
+    the exact surface. Motion is the ellipsoid normal (step 5). Moments are taken about the
+    centre of pressure ``center`` (step 1), the frame origin for the standard fields.
 
     Attributes
     ----------
@@ -79,6 +156,8 @@ class Ellipsoid(FrictionModel):
         Maximum moment over maximum force [m] (the paper's ``lambda``).
     tilt : tuple of float
         Force at maximum moment over the maximum force [-]; ``(0, 0)`` for symmetric pressure.
+    center : tuple of float
+        Centre of pressure [m] about which the moments are taken.
     normal_force : float
         Default normal force of the numeric methods [N].
     """
@@ -86,17 +165,13 @@ class Ellipsoid(FrictionModel):
     mu: float
     rho: float
     tilt: tuple[float, float] = (0.0, 0.0)
+    center: tuple[float, float] = (0.0, 0.0)
     normal_force: float = 1.0
 
     conservative: ClassVar[bool] = False
 
     def __post_init__(self):
-        object.__setattr__(self, "mu", validation.positive_scalar("mu", self.mu))
-        object.__setattr__(self, "rho", validation.positive_scalar("rho", self.rho))
-        object.__setattr__(self, "tilt", finite_pair("tilt", self.tilt))
-        object.__setattr__(
-            self, "normal_force", validation.positive_scalar("normal_force", self.normal_force)
-        )
+        check_area(self)
 
     @classmethod
     def from_limit_surface(cls, ls: LimitSurface, *, tilted: bool = True) -> Ellipsoid:
@@ -105,9 +180,7 @@ class Ellipsoid(FrictionModel):
         With ``tilted=False`` the major axis is taken vertical even for asymmetric pressure
         (the paper's choice when ``fx0`` and ``fy0`` are small).
         """
-        mu, rho, normal_force = surface_units(ls)
-        tilt = surface_tilt(ls) if tilted else (0.0, 0.0)
-        return cls(mu=mu, rho=rho, tilt=tilt, normal_force=normal_force)
+        return cls(**area_parameters(ls, tilted))
 
     @classmethod
     def from_limits(
@@ -117,19 +190,12 @@ class Ellipsoid(FrictionModel):
         max_moment: float,
         normal_force: float = 1.0,
         apex_force: tuple[float, float] = (0.0, 0.0),
+        center: tuple[float, float] = (0.0, 0.0),
     ) -> Ellipsoid:
-        """From measured (or computed) maximum force [N] and moment [N m] at ``normal_force``
-        [N]; ``apex_force`` [N] is the force of the load at maximum moment (tilt)."""
-        max_force = validation.positive_scalar("max_force", max_force)
-        max_moment = validation.positive_scalar("max_moment", max_moment)
-        normal_force = validation.positive_scalar("normal_force", normal_force)
-        apex = finite_pair("apex_force", apex_force)
-        return cls(
-            mu=max_force / normal_force,
-            rho=max_moment / max_force,
-            tilt=(apex[0] / max_force, apex[1] / max_force),
-            normal_force=normal_force,
-        )
+        """From measured (or computed) largest force [N] and moment [N m] about ``center``
+        [m] at ``normal_force`` [N]; ``apex_force`` [N] is the force of the load at largest
+        moment (tilt)."""
+        return cls(**limit_parameters(max_force, max_moment, normal_force, apex_force, center))
 
     @property
     def matrix(self) -> np.ndarray:
@@ -152,11 +218,7 @@ class Ellipsoid(FrictionModel):
         return [cp.SOC(normal_force, _shear(self.tilt) @ q)]
 
     def __repr__(self) -> str:
-        tilt = f"({fmt(self.tilt[0])}, {fmt(self.tilt[1])})"
-        return (
-            f"Ellipsoid(mu={fmt(self.mu)}, rho={fmt(self.rho)} m, tilt={tilt}, "
-            f"normal_force={fmt(self.normal_force)} N)"
-        )
+        return area_repr(self)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, repr=False, eq=False)
@@ -180,6 +242,8 @@ class FittedEllipsoid(FrictionModel):
         ``M`` (3x3), in normalised coordinates ``q`` of ``mu`` and ``rho``.
     mu, rho : float
         Normalisation units: friction per unit normal force [-] and length [m].
+    center : tuple of float
+        Point [m] about which the moments of ``q`` are taken (the centre of pressure).
     normal_force : float
         Default normal force of the numeric methods [N].
     fit_error : float
@@ -189,6 +253,7 @@ class FittedEllipsoid(FrictionModel):
     matrix: np.ndarray
     mu: float
     rho: float
+    center: tuple[float, float] = (0.0, 0.0)
     normal_force: float = 1.0
     fit_error: float = 0.0
     _factor: np.ndarray = field(init=False)
@@ -208,6 +273,7 @@ class FittedEllipsoid(FrictionModel):
         object.__setattr__(self, "_factor", factor)
         object.__setattr__(self, "mu", validation.positive_scalar("mu", self.mu))
         object.__setattr__(self, "rho", validation.positive_scalar("rho", self.rho))
+        object.__setattr__(self, "center", finite_pair("center", self.center))
         object.__setattr__(
             self, "normal_force", validation.positive_scalar("normal_force", self.normal_force)
         )
@@ -219,13 +285,25 @@ class FittedEllipsoid(FrictionModel):
     def from_limit_surface(
         cls, ls: LimitSurface, *, samples: int = DEFAULT_FIT_SAMPLES
     ) -> FittedEllipsoid:
-        """Fit to ``samples`` loads spread evenly over the exact surface (``ls.sample``)."""
+        """Fit to ``samples`` loads on the exact surface, spread evenly in direction.
+
+        The directions are a Fibonacci lattice in the normalised coordinates of the Table 2
+        ellipsoid (moments about the centre of pressure), so the fit does not depend on where
+        the frame origin lies.
+        """
         if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 6:
             raise InvalidArgumentError(f"samples must be an integer >= 6, got {samples!r}")
-        mu, rho, normal_force = surface_units(ls)
-        points = ls.sample(int(samples), normalized=True)
+        parameters = area_parameters(ls, tilted=False)
+        del parameters["tilt"]
+        frame = Ellipsoid(**parameters)
+        directions = fibonacci_sphere(int(samples))
+        units = frame._units() * frame.normal_force
+        cx, cy = frame.center
+        loads = directions * units
+        loads[:, 2] += cx * loads[:, 1] - cy * loads[:, 0]  # moments about the origin
+        points = directions * np.atleast_1d(ls.safety_factor(loads))[:, None]
         matrix, error = fit_ellipsoid(points)
-        return cls(matrix=matrix, mu=mu, rho=rho, normal_force=normal_force, fit_error=error)
+        return cls(matrix=matrix, fit_error=error, **parameters)
 
     @classmethod
     def from_loads(cls, loads, *, normal_force: float) -> FittedEllipsoid:
@@ -283,8 +361,11 @@ class FittedEllipsoid(FrictionModel):
         return [cp.SOC(normal_force, self._factor @ q)]
 
     def __repr__(self) -> str:
+        center = ""
+        if self.center != (0.0, 0.0):
+            center = f"center=({fmt(self.center[0])}, {fmt(self.center[1])}) m, "
         return (
-            f"FittedEllipsoid(mu={fmt(self.mu)}, rho={fmt(self.rho)} m, "
+            f"FittedEllipsoid(mu={fmt(self.mu)}, rho={fmt(self.rho)} m, {center}"
             f"normal_force={fmt(self.normal_force)} N, fit_error={self.fit_error:.3g})"
         )
 
@@ -363,8 +444,11 @@ class FacetedEllipsoid(FrictionModel):
             raise InvalidArgumentError(
                 "points (P, 2) and facet_support (P,) must have the same P >= 1, support > 0"
             )
-        twists = np.column_stack([points[:, 1], -points[:, 0], np.ones(len(points))])
-        # Facet i in normalised coordinates: |a_i · q| <= 1, a_i = units * V_i / h_i.
+        # Twist V_i of rotation about point i, written about the centre c (the velocity of
+        # the body point at c), so that V_i · L = V_i,c · (f, m - c × f).
+        cx, cy = self.ellipsoid.center
+        twists = np.column_stack([points[:, 1] - cy, cx - points[:, 0], np.ones(len(points))])
+        # Facet i in normalised coordinates: |a_i · q| <= 1, a_i = units * V_i,c / h_i.
         planes = twists * self.ellipsoid._units()[None, :] / support[:, None]
         planes.setflags(write=False)
         object.__setattr__(self, "points", points)
@@ -406,6 +490,10 @@ class FacetedEllipsoid(FrictionModel):
     @property
     def rho(self) -> float:
         return self.ellipsoid.rho
+
+    @property
+    def center(self) -> tuple[float, float]:
+        return self.ellipsoid.center
 
     @property
     def normal_force(self) -> float:

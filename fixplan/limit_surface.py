@@ -199,10 +199,13 @@ class LimitSurface:
         safety = np.full(len(loads), np.inf)
         twists = np.full((len(loads), 3), np.nan)
         nonzero = np.flatnonzero(np.any(loads != 0.0, axis=1))
+        # Solve for loads of unit size (normalised): s(c L) = s(L) / c.
+        size = np.max(np.abs(loads[nonzero] / self._units), axis=1)
         for start in range(0, len(nonzero), _CHUNK):
             rows = nonzero[start : start + _CHUNK]
-            result = solve(self._kernel, self._scale, loads[rows], self._units)
-            safety[rows] = result.safety_factor
+            scale = size[start : start + _CHUNK, None]
+            result = solve(self._kernel, self._scale, loads[rows] / scale, self._units)
+            safety[rows] = result.safety_factor / scale[:, 0]
             twists[rows] = result.twist
         return safety, twists, single
 

@@ -9,14 +9,17 @@ coordinates of the paper (Table 2, step 3),
 
 where ``mu`` is the model's friction coefficient (maximum force per unit normal force) and
 ``rho`` [m] its characteristic length (maximum moment over maximum force, the paper's
-``lambda``). There the set is ``{q : g(q) <= 1}`` for a gauge ``g`` (a positively homogeneous
-convex function), so that
+``lambda``). The moment ``m`` is taken about the model's ``center``, the centre of pressure
+(paper eq. 2 and Table 2, step 1), which is the frame origin for the standard fields; loads and
+twists are still given and returned about the frame origin (DESIGN.md §2). There the set is
+``{q : g(q) <= 1}`` for a gauge ``g`` (a positively homogeneous convex function), so that
 
 - the safety factor of a load is ``1 / g(q)``;
 - the model holds the load when the safety factor is at least ``1 - CONTAINMENT_RTOL``;
 - the sliding motion, for models that have one, is the outward normal ``∇g(q)`` of the set at
   the load scaled onto its boundary (normality); returned as a twist ``(vx, vy, w)`` scaled so
-  that ``(vx, vy, rho * w)`` has unit norm, like :meth:`fixplan.LimitSurface.motion`;
+  that the twist about the centre, ``(vx - cy w, vy + cx w, rho * w)``, has unit norm (with the
+  centre at the origin, as :meth:`fixplan.LimitSurface.motion` does);
 - as cvxpy constraints the set is ``g(q) <= N`` with ``q = (fx/mu, fy/mu, m/(mu rho))``, which
   is homogeneous in ``N``: ``N`` may be a float, a Parameter or an affine expression of
   variables (the normal force of a contact that the planner chooses).
@@ -85,6 +88,20 @@ class FrictionModel(ABC):
         return 0.0
 
     @property
+    def center(self) -> tuple[float, float]:
+        """Point [m] about which the model takes moments: the centre of pressure."""
+        return (0.0, 0.0)
+
+    def _about_center(self, loads: np.ndarray) -> np.ndarray:
+        """Loads ``(K, 3)`` with the moment taken about :attr:`center`: ``m - c × f``."""
+        cx, cy = self.center
+        if cx == 0.0 and cy == 0.0:
+            return loads
+        moved = loads.copy()
+        moved[:, 2] -= cx * loads[:, 1] - cy * loads[:, 0]
+        return moved
+
+    @property
     def has_motion(self) -> bool:
         """Whether :meth:`motion` is defined (the normals of the set give the sliding twist)."""
         return type(self)._normal is not FrictionModel._normal
@@ -101,7 +118,8 @@ class FrictionModel(ABC):
 
     @property
     def max_moment(self) -> float:
-        """Largest friction moment [N m] at the model's ``normal_force`` (0: point models)."""
+        """Largest friction moment [N m] about :attr:`center` at the model's ``normal_force``
+        (0 for point models)."""
         return self.mu * self.rho * self.normal_force
 
     def _units(self) -> np.ndarray:
@@ -121,6 +139,7 @@ class FrictionModel(ABC):
         )
         if self.torsion:
             loads, single = validation.vector_batch("load", load, width=3)
+            loads = self._about_center(loads)
             twisted = np.zeros(len(loads), dtype=bool)
         else:
             loads, single = _point_loads(load)
@@ -161,7 +180,9 @@ class FrictionModel(ABC):
         """Unit twist of impending sliding under ``load``, by normality on the model's surface.
 
         The load is scaled onto the surface first (its magnitude does not matter). The twist
-        ``(vx, vy, w)`` is scaled so that ``(vx, vy, rho * w)`` has unit norm; point models
+        ``(vx, vy, w)`` (velocity of the body point at the frame origin) is scaled so that the
+        twist about :attr:`center`, ``(vx - cy w, vy + cx w, rho * w)``, has unit norm (for the
+        standard fields ``center`` is the origin, as for ``LimitSurface.motion``); point models
         return the unit sliding velocity ``(vx, vy)`` (``(vx, vy, 0)`` for 3-vector loads).
         NaN for the zero load and for a point model loaded by a moment.
 
@@ -178,7 +199,12 @@ class FrictionModel(ABC):
             normals[moving] = self._normal(q[moving])
         normals /= np.linalg.norm(normals, axis=1, keepdims=True)
         if self.torsion:
+            # Normal n in q coordinates -> twist about the centre (n_f, n_m / rho) -> about the
+            # origin: the origin moves with v_c + w J (0 - c) = (vx + cy w, vy - cx w).
             twists = normals / np.array([1.0, 1.0, self.rho])
+            cx, cy = self.center
+            twists[:, 0] += cy * twists[:, 2]
+            twists[:, 1] -= cx * twists[:, 2]
         else:
             twists = normals
             if np.ndim(load) and np.shape(load)[-1] == 3:
@@ -252,6 +278,7 @@ class FrictionModel(ABC):
         if normal_force.shape == (1,):
             normal_force = cp.reshape(normal_force, (), order="C")
         allowed = ((3,),) if self.torsion else ((2,), (3,))
+        cx, cy = self.center
         if load.shape not in allowed:
             raise InvalidArgumentError(
                 f"load must have shape {' or '.join(str(s) for s in allowed)} for "
@@ -261,6 +288,8 @@ class FrictionModel(ABC):
         if not self.torsion and load.shape == (3,):
             extra.append(load[2] == 0.0)
             load = load[:2]
+        elif cx != 0.0 or cy != 0.0:
+            load = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [cy, -cx, 1.0]]) @ load
         q = cp.multiply(1.0 / self._units(), load)
         return self._unit_constraints(q, normal_force) + extra
 

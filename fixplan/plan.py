@@ -107,7 +107,9 @@ class Plan:
         return {
             "status": self.status,
             "objective": self.objective,
-            "objective_value": None if self.objective_value is None else number(self.objective_value),
+            "objective_value": None
+            if self.objective_value is None
+            else number(self.objective_value),
             "forces_N": forces,
             "safety_factors": {k: number(v) for k, v in self.safety_factors.items()},
             "safety_factor": None if self.safety_factor is None else number(self.safety_factor),

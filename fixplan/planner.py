@@ -33,6 +33,7 @@ from fixplan.screw import Screw
 from fixplan.tolerances import (
     EQUILIBRIUM_RTOL,
     FRICTION_SET_RTOL,
+    HELD_RTOL,
     MAX_SAFETY_FACTOR,
 )
 
@@ -43,7 +44,7 @@ _FALLBACK = {"CLARABEL": "SCS", "SCS": "CLARABEL", "OSQP": "CLARABEL"}
 _SOLVER_OPTIONS = {
     "CLARABEL": {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9},
     "SCS": {"eps": 1e-9, "max_iters": 200_000},
-    "OSQP": {"eps_abs": 1e-9, "eps_rel": 1e-9, "max_iter": 200_000, "polish": True},
+    "OSQP": {"eps_abs": 1e-8, "eps_rel": 1e-8, "max_iter": 50_000, "polish": True},
 }
 _STATUS = {
     cp.OPTIMAL: "optimal",
@@ -53,10 +54,6 @@ _STATUS = {
     cp.UNBOUNDED: "unbounded",
     cp.UNBOUNDED_INACCURATE: "unbounded",
 }
-
-
-class SolverFailure(FixplanError, RuntimeError):
-    """The solver and its fallback both failed."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -89,7 +86,9 @@ class Planner:
             raise InvalidArgumentError(f"problem must be a Problem, got {type(problem).__name__}")
         solver = "CLARABEL" if solver is None else str(solver).upper()
         if solver not in SOLVERS:
-            raise InvalidArgumentError(f"solver must be one of {', '.join(SOLVERS)}; got {solver!r}")
+            raise InvalidArgumentError(
+                f"solver must be one of {', '.join(SOLVERS)}; got {solver!r}"
+            )
         self.problem = problem
         self.solver = solver
         self.models = [contact_model(c) for c in problem.contacts]
@@ -155,7 +154,9 @@ class Planner:
             scale = cp.Constant(ones)
             task_term = task
         gravity_term = cp.reshape(gravity, (6, 1), order="C") @ np.ones((1, cases))
-        balance = self._normal_map @ normal + self._friction_map @ friction + task_term + gravity_term
+        balance = (
+            self._normal_map @ normal + self._friction_map @ friction + task_term + gravity_term
+        )
         balance_constraint = balance == 0
         constraints.append(balance_constraint)
         for i, model in enumerate(self.models):
@@ -300,7 +301,9 @@ class Planner:
         built.gravity.value = self.problem.body.weight_wrench
         for i, parameter in built.fixed.items():
             value = fixed_values[i]
-            parameter.value = value if parameter.ndim == 0 else np.broadcast_to(value, parameter.shape)
+            parameter.value = (
+                value if parameter.ndim == 0 else np.broadcast_to(value, parameter.shape)
+            )
         notes = []
         solver = self.solver
         status = self._call(built.problem, solver)
@@ -346,7 +349,9 @@ class Planner:
         friction_part = self._friction_map @ friction
         task_part = wrenches * scale[None, :]
         residual = normal_part + friction_part + task_part + gravity
-        magnitude = np.abs(normal_part) + np.abs(friction_part) + np.abs(task_part) + np.abs(gravity)
+        magnitude = (
+            np.abs(normal_part) + np.abs(friction_part) + np.abs(task_part) + np.abs(gravity)
+        )
         relative = 0.0
         force_size = max(float(magnitude[:3].max()), 1e-12)
         sizes = (force_size, max(float(magnitude[3:].max()), force_size * self.length_scale))
@@ -416,15 +421,17 @@ class Planner:
         scale = result["scale"]
         safety = np.where(scale >= MAX_SAFETY_FACTOR * (1 - 1e-6), np.inf, scale)
         dual = result.get("dual")
+        normal, friction = result["normal"], result["friction"]
         motions = {}
         for j, name in enumerate(names):
             twist = None if dual is None or not np.isfinite(safety[j]) else dual[:, j]
+            if twist is not None:
+                twist = self._keep_contact(twist, normal[:, j])
             if twist is None or not np.any(twist):
                 motions[name] = None
                 continue
             twist = twist if wrenches[:, j] @ twist >= 0.0 else -twist
             motions[name] = Screw.from_twist(twist, self.length_scale)
-        normal, friction = result["normal"], result["friction"]
         utilisation = np.zeros(normal.shape)
         for i, model in enumerate(self.models):
             fn = normal[i]
@@ -434,16 +441,42 @@ class Planner:
                 utilisation[i, pressed] = 1.0 / np.atleast_1d(
                     model.safety_factor(load[pressed] / fn[pressed, None])
                 )
-        critical = int(np.argmin(safety))
+        # Cases tied with the smallest safety factor (within solver accuracy): the first.
+        critical = int(np.flatnonzero(safety <= safety.min() * (1.0 + HELD_RTOL))[0])
         return {
             "safety_factors": {name: float(s) for name, s in zip(names, safety, strict=True)},
             "safety_factor": float(safety.min()),
-            "held": {name: bool(s >= 1.0 - 1e-9) for name, s in zip(names, safety, strict=True)},
+            "held": {
+                name: bool(s >= 1.0 - HELD_RTOL) for name, s in zip(names, safety, strict=True)
+            },
             "motions": motions,
             "utilisation": utilisation,
             "critical_load": names[critical],
-            "critical_contact": self.problem.contacts[int(np.argmax(utilisation[:, critical]))].name,
+            "critical_contact": self.problem.contacts[
+                int(np.argmax(utilisation[:, critical]))
+            ].name,
         }
+
+    def _keep_contact(self, twist: np.ndarray, normal_forces: np.ndarray) -> np.ndarray | None:
+        """The twist nearest ``twist`` in which every pressed contact stays in contact.
+
+        The dual of the equilibrium is the associated flow of the Coulomb cones, which lifts a
+        sliding contact off by ``mu`` times its sliding speed (dilatancy). Real contacts that
+        press keep touching, so the normal velocity of the body at each pressed contact is
+        projected out. ``None`` when nothing is left (the contacts allow no sliding).
+        """
+        size = max(float(np.abs(normal_forces).max()), 1e-300)
+        pressed = np.flatnonzero(normal_forces > FRICTION_SET_RTOL * size)
+        if pressed.size == 0:
+            return twist
+        # Normal velocity of the body at contact i: n·(v + ω × p) = G_n[:, i] · (v, ω).
+        rows = self._normal_map[:, pressed].T
+        basis = np.linalg.svd(rows)[2]
+        rank = int(np.sum(np.linalg.svd(rows, compute_uv=False) > 1e-9 * self.length_scale))
+        free = basis[rank:]
+        projected = free.T @ (free @ twist)
+        scale = np.linalg.norm(twist)
+        return projected if np.linalg.norm(projected) > 1e-9 * scale else None
 
     def _certificate(self, result, wrenches, names) -> tuple[dict, str]:
         """The unresisted motions of an infeasible problem, in words."""

@@ -146,7 +146,9 @@ class PointSetKernel(SupportKernel):
         twists = np.ascontiguousarray(twists, dtype=float)
         h = np.empty(len(twists))
         loads = np.empty((len(twists), 3))
-        _pick(_EVALUATE, len(twists), len(self._x))(self._x, self._y, self.weights, twists, h, loads)
+        _pick(_EVALUATE, len(twists), len(self._x))(
+            self._x, self._y, self.weights, twists, h, loads
+        )
         return h, loads
 
     def newton_terms(self, twists):

@@ -15,24 +15,20 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 
 from fixplan import validation
-from fixplan.ellipsoid_models import _shear, surface_tilt, surface_units
-from fixplan.model_base import FrictionModel, facet_count, finite_pair, fmt, polygon_normals
+from fixplan.ellipsoid_models import (
+    _shear,
+    area_parameters,
+    area_repr,
+    check_area,
+    limit_parameters,
+    surface_axis,
+    surface_units,
+)
+from fixplan.errors import InvalidArgumentError
+from fixplan.model_base import FrictionModel, facet_count, fmt, polygon_normals
 
 if TYPE_CHECKING:  # pragma: no cover
     from fixplan.limit_surface import LimitSurface
-
-
-def _check_area(model) -> None:
-    object.__setattr__(model, "mu", validation.positive_scalar("mu", model.mu))
-    object.__setattr__(model, "rho", validation.positive_scalar("rho", model.rho))
-    object.__setattr__(model, "tilt", finite_pair("tilt", model.tilt))
-    object.__setattr__(
-        model, "normal_force", validation.positive_scalar("normal_force", model.normal_force)
-    )
-
-
-def _tilt_text(tilt: tuple[float, float]) -> str:
-    return f"({fmt(tilt[0])}, {fmt(tilt[1])})"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, repr=False)
@@ -46,9 +42,10 @@ class Cone(FrictionModel):
     the convex hull of the pure-translation circle and the two loads at maximum moment
     ``±(t, 1)``; all of them lie on the exact limit surface, which is convex, so the cone lies
     inside it: conservative for every contact (paper §4.2). ``t`` tilts the axis through the
-    load at maximum moment, as for :class:`~fixplan.models.Ellipsoid`. Any section through the
-    moment axis is the straight line ``|f|/max_force + |m|/max_moment = 1`` of the paper's
-    moment-force plots (:meth:`curve`).
+    load at maximum moment, as for :class:`~fixplan.models.Ellipsoid`; moments are taken about
+    the centre of pressure ``center``, where the translation loads have no moment. Any section
+    through the moment axis is the straight line ``|f|/max_force + |m|/max_moment = 1`` of the
+    paper's moment-force plots (:meth:`curve`).
 
     Attributes
     ----------
@@ -58,6 +55,8 @@ class Cone(FrictionModel):
         Maximum moment over maximum force [m].
     tilt : tuple of float
         Force at maximum moment over the maximum force [-].
+    center : tuple of float
+        Centre of pressure [m] about which the moments are taken.
     normal_force : float
         Default normal force of the numeric methods [N].
     """
@@ -65,19 +64,18 @@ class Cone(FrictionModel):
     mu: float
     rho: float
     tilt: tuple[float, float] = (0.0, 0.0)
+    center: tuple[float, float] = (0.0, 0.0)
     normal_force: float = 1.0
 
     conservative: ClassVar[bool] = True
 
     def __post_init__(self):
-        _check_area(self)
+        check_area(self)
 
     @classmethod
     def from_limit_surface(cls, ls: LimitSurface, *, tilted: bool = True) -> Cone:
         """The cone of an exact limit surface (tilted through its load at maximum moment)."""
-        mu, rho, normal_force = surface_units(ls)
-        tilt = surface_tilt(ls) if tilted else (0.0, 0.0)
-        return cls(mu=mu, rho=rho, tilt=tilt, normal_force=normal_force)
+        return cls(**area_parameters(ls, tilted))
 
     @classmethod
     def from_limits(
@@ -87,19 +85,11 @@ class Cone(FrictionModel):
         max_moment: float,
         normal_force: float = 1.0,
         apex_force: tuple[float, float] = (0.0, 0.0),
+        center: tuple[float, float] = (0.0, 0.0),
     ) -> Cone:
-        """From maximum force [N] and moment [N m] at ``normal_force`` [N]; ``apex_force`` [N]
-        is the force of the load at maximum moment."""
-        max_force = validation.positive_scalar("max_force", max_force)
-        max_moment = validation.positive_scalar("max_moment", max_moment)
-        normal_force = validation.positive_scalar("normal_force", normal_force)
-        apex = finite_pair("apex_force", apex_force)
-        return cls(
-            mu=max_force / normal_force,
-            rho=max_moment / max_force,
-            tilt=(apex[0] / max_force, apex[1] / max_force),
-            normal_force=normal_force,
-        )
+        """From the largest force [N] and moment [N m] about ``center`` [m] at
+        ``normal_force`` [N]; ``apex_force`` [N] is the force of the load at largest moment."""
+        return cls(**limit_parameters(max_force, max_moment, normal_force, apex_force, center))
 
     def _gauge(self, q):
         t = self.tilt
@@ -114,10 +104,7 @@ class Cone(FrictionModel):
         return [cp.norm(force, 2) + cp.abs(q[2]) <= normal_force]
 
     def __repr__(self) -> str:
-        return (
-            f"Cone(mu={fmt(self.mu)}, rho={fmt(self.rho)} m, tilt={_tilt_text(self.tilt)}, "
-            f"normal_force={fmt(self.normal_force)} N)"
-        )
+        return area_repr(self)
 
 
 def _apothem(facets: int, inscribed: bool) -> float:
@@ -153,7 +140,7 @@ class Pyramid(FrictionModel):
 
     Attributes
     ----------
-    mu, rho, tilt, normal_force
+    mu, rho, tilt, center, normal_force
         As for :class:`Cone`.
     facets : int
         Number of facets ``k >= 3`` of the force polygon.
@@ -164,13 +151,14 @@ class Pyramid(FrictionModel):
     mu: float
     rho: float
     tilt: tuple[float, float] = (0.0, 0.0)
+    center: tuple[float, float] = (0.0, 0.0)
     facets: int = 4
     inscribed: bool = True
     normal_force: float = 1.0
     _rows: np.ndarray = field(init=False, compare=False)
 
     def __post_init__(self):
-        _check_area(self)
+        check_area(self)
         object.__setattr__(self, "facets", facet_count(self.facets))
         object.__setattr__(self, "inscribed", bool(self.inscribed))
         normals = polygon_normals(self.facets) / _apothem(self.facets, self.inscribed)
@@ -194,16 +182,23 @@ class Pyramid(FrictionModel):
         cls, ls: LimitSurface, *, facets: int = 4, inscribed: bool = True, tilted: bool = True
     ) -> Pyramid:
         """The pyramid of an exact limit surface (tilted through its load at maximum moment)."""
-        mu, rho, normal_force = surface_units(ls)
-        tilt = surface_tilt(ls) if tilted else (0.0, 0.0)
-        return cls(
-            mu=mu,
-            rho=rho,
-            tilt=tilt,
-            facets=facets,
-            inscribed=inscribed,
-            normal_force=normal_force,
-        )
+        return cls(facets=facets, inscribed=inscribed, **area_parameters(ls, tilted))
+
+    @classmethod
+    def from_limits(
+        cls,
+        *,
+        max_force: float,
+        max_moment: float,
+        normal_force: float = 1.0,
+        apex_force: tuple[float, float] = (0.0, 0.0),
+        center: tuple[float, float] = (0.0, 0.0),
+        facets: int = 4,
+        inscribed: bool = True,
+    ) -> Pyramid:
+        """As :meth:`Cone.from_limits`, with ``facets`` and ``inscribed``."""
+        parameters = limit_parameters(max_force, max_moment, normal_force, apex_force, center)
+        return cls(facets=facets, inscribed=inscribed, **parameters)
 
     def inequalities(self, *, normal_force: float | None = None) -> tuple[np.ndarray, np.ndarray]:
         """``(A, b)`` with the pyramid ``{L : A @ L <= b}`` for loads ``L`` [N, N, N m].
@@ -212,7 +207,10 @@ class Pyramid(FrictionModel):
         """
         force = self.normal_force if normal_force is None else normal_force
         force = validation.positive_scalar("normal_force", force)
-        return self._rows / self._units()[None, :], np.full(len(self._rows), force)
+        cx, cy = self.center
+        about_center = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [cy, -cx, 1.0]])
+        matrix = self._rows / self._units()[None, :] @ about_center
+        return matrix, np.full(len(self._rows), force)
 
     def _gauge(self, q):
         t = self.tilt
@@ -226,14 +224,23 @@ class Pyramid(FrictionModel):
 
     def __repr__(self) -> str:
         kind = "inscribed" if self.inscribed else "circumscribed"
-        return (
-            f"Pyramid(facets={self.facets}, {kind}, mu={fmt(self.mu)}, rho={fmt(self.rho)} m, "
-            f"tilt={_tilt_text(self.tilt)}, normal_force={fmt(self.normal_force)} N)"
-        )
+        return area_repr(self, f"facets={self.facets}, {kind}, ")
 
 
 def _point_mu(ls: LimitSurface) -> tuple[float, float]:
+    """Friction coefficient and normal force of a point model of ``ls``.
+
+    Only the section ``m = 0`` about the centre of pressure is the whole disk of radius
+    ``max_force``; about another origin the disk would stick out of the surface.
+    """
     mu, _, normal_force = surface_units(ls)
+    (cx, cy), _, _ = surface_axis(ls)
+    if cx != 0.0 or cy != 0.0:
+        raise InvalidArgumentError(
+            f"the frame origin of {ls!r} is not its centre of pressure ({cx:.6g}, {cy:.6g}) m: "
+            "a point contact bears no moment, so place it at the centre of pressure (build the "
+            "surface of field.shifted(-cx, -cy))"
+        )
     return mu, normal_force
 
 
@@ -242,7 +249,7 @@ class PointCone(FrictionModel):
     r"""Coulomb's friction cone of a point contact: ``‖(fx, fy)‖ <= mu N``, no torsion.
 
     A second-order cone. It is the ``m = 0`` section of any limit surface with friction
-    ``mu``, hence conservative. Motion: the point slides along the applied force (maximum
+    ``mu`` written about its centre of pressure, hence conservative. Motion: the point slides along the applied force (maximum
     dissipation), returned as a unit velocity.
 
     Attributes

@@ -185,9 +185,7 @@ class Contact:
         where = f"contact {self.name!r}" if isinstance(self.name, str) else "contact"
         _name(f"{where}.name", self.name)
         if self.role not in ROLES:
-            raise ProblemError(
-                f"{where}.role must be one of {', '.join(ROLES)}; got {self.role!r}"
-            )
+            raise ProblemError(f"{where}.role must be one of {', '.join(ROLES)}; got {self.role!r}")
         object.__setattr__(self, "position", _vector(f"{where}.position", self.position))
         object.__setattr__(self, "normal", _vector(f"{where}.normal", self.normal, unit=True))
         object.__setattr__(self, "mu", _scalar(f"{where}.mu", self.mu, positive=True))
@@ -232,9 +230,11 @@ class Contact:
             pyramid = False
         if not pyramid and (self.facets is not None or self.inscribed is not None):
             raise ProblemError(f"{where}.facets and .inscribed are only for pyramid models")
-        if self.facets is not None:
-            if not isinstance(self.facets, int | np.integer) or self.facets < 3:
-                raise ProblemError(f"{where}.facets must be an integer >= 3, got {self.facets!r}")
+        facets = self.facets
+        if facets is not None and (
+            isinstance(facets, bool) or not isinstance(facets, int | np.integer) or facets < 3
+        ):
+            raise ProblemError(f"{where}.facets must be an integer >= 3, got {facets!r}")
         if self.inscribed is not None and not isinstance(self.inscribed, bool | np.bool_):
             raise ProblemError(f"{where}.inscribed must be true or false, got {self.inscribed!r}")
 
@@ -319,5 +319,3 @@ class Problem:
             )
         object.__setattr__(self, "contacts", contacts)
         object.__setattr__(self, "loads", loads)
-
-

@@ -11,13 +11,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fixplan.tolerances import SCREW_PRINT_RTOL
+
 #: A twist whose rotation moves points at this distance [m] less than this fraction of its
 #: translation is reported as a pure translation.
 TRANSLATION_RTOL = 1e-9
 
 
-def _fmt(vector: np.ndarray, digits: int = 4) -> str:
-    cleaned = np.where(np.abs(vector) < 10.0 ** (-digits - 2) * np.max(np.abs(vector)), 0.0, vector)
+def _fmt(vector: np.ndarray, noise: float, digits: int = 4) -> str:
+    """``vector`` in parentheses, entries smaller than ``noise`` printed as 0."""
+    cleaned = np.where(np.abs(vector) < noise, 0.0, vector)
     return "(" + ", ".join(f"{x:.{digits}g}" for x in cleaned + 0.0) + ")"
 
 
@@ -36,12 +39,15 @@ class Screw:
         Point of the axis closest to the world origin [m] (``None`` for a translation).
     pitch : float
         Translation per radian along the axis [m/rad] (``inf`` for a translation).
+    length_scale : float
+        The body's length scale [m]; sets what counts as solver noise when printing.
     """
 
     twist: np.ndarray
     direction: np.ndarray
     point: np.ndarray | None
     pitch: float
+    length_scale: float = 1.0
 
     @classmethod
     def from_twist(cls, twist: np.ndarray, length_scale: float) -> Screw:
@@ -56,11 +62,18 @@ class Screw:
                 direction=v / np.linalg.norm(v),
                 point=None,
                 pitch=float("inf"),
+                length_scale=length_scale,
             )
         direction = omega / spin
         point = np.cross(omega, v) / spin**2
         pitch = float(omega @ v) / spin**2
-        return cls(twist=np.concatenate([v, omega]), direction=direction, point=point, pitch=pitch)
+        return cls(
+            twist=np.concatenate([v, omega]),
+            direction=direction,
+            point=point,
+            pitch=pitch,
+            length_scale=length_scale,
+        )
 
     @property
     def is_translation(self) -> bool:
@@ -69,10 +82,12 @@ class Screw:
 
     def describe(self) -> str:
         """The motion in words."""
+        along = _fmt(self.direction, SCREW_PRINT_RTOL)
         if self.is_translation:
-            return f"translates along {_fmt(self.direction)}"
-        text = f"rotates about an axis through {_fmt(self.point)} m along {_fmt(self.direction)}"
-        if abs(self.pitch) > 1e-9:
+            return f"translates along {along}"
+        through = _fmt(self.point, SCREW_PRINT_RTOL * self.length_scale)
+        text = f"rotates about an axis through {through} m along {along}"
+        if abs(self.pitch) > SCREW_PRINT_RTOL * self.length_scale:
             text += f", advancing {self.pitch:.4g} m/rad along it"
         return text
 

@@ -45,10 +45,19 @@ MAX_SAFETY_FACTOR = 1e3
 #: positive definite (a bounded set) when the data leave a direction unconstrained.
 FIT_MIN_EIGENVALUE = 1e-6
 
-#: A component of the normalised force at maximum moment below this is rounding noise of a
-#: symmetric pressure field; the ellipsoid, cone and pyramid are then not tilted.
+#: A component of the normalised force at maximum moment (or of the centre of pressure, in
+#: units of the characteristic length) below this is rounding noise of a symmetric pressure
+#: field; the ellipsoid, cone and pyramid are then not tilted (not moved).
 TILT_ATOL = 1e-12
 
 #: A model overestimates the limit surface ("unsafe") in a direction where its radius exceeds
 #: the exact one by more than this fraction (the exact inverse map is accurate to ~1e-15).
 UNSAFE_RTOL = 1e-9
+
+#: A load case counts as held when its safety factor is at least ``1 - HELD_RTOL`` (the conic
+#: solvers' accuracy); load cases whose safety factors agree within it are tied.
+HELD_RTOL = 1e-6
+
+#: Screw-axis points closer than this fraction of the body's length scale to a coordinate
+#: plane are printed on it (solver noise).
+SCREW_PRINT_RTOL = 1e-6

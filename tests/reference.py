@@ -68,7 +68,7 @@ from typing import NamedTuple
 import mpmath
 import numpy as np
 
-#: Significant digits of the mpmath closed forms.
+#: Significant digits of the mpmath closed forms (more for far CORs, see :func:`closed_form`).
 CLOSED_FORM_DPS = 40
 
 Function = Callable[[np.ndarray, np.ndarray], np.ndarray]
@@ -281,7 +281,10 @@ def closed_form(
             speed = math.hypot(local_twist[0], local_twist[1])
             return speed, np.array([local_twist[0] / speed, local_twist[1] / speed, 0.0])
         w = float(local_twist[2])
-        with mpmath.workdps(CLOSED_FORM_DPS):
+        # The forms cancel like (|c| / size)^3 far away: carry that many more digits.
+        size = math.hypot(length, width) / 2 if shape == "rectangle" else radius
+        extra = 3 * max(0, math.ceil(math.log10(max(1.0, math.hypot(*cor) / size))))
+        with mpmath.workdps(CLOSED_FORM_DPS + extra):
             if shape == "rectangle":
                 moment, load = _rectangle_ccw(length, width, cor)
             else:

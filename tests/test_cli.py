@@ -113,7 +113,7 @@ def test_check_reports_every_problem_of_a_file_and_exits_with_2(tmp_path, capsys
         path.read_text()
         .replace("mu = 0.8", "mu = -0.8")
         .replace('role = "finger"\nposition = [0.0, 0.02', 'role = "fingr"\nposition = [0.0, 0.02')
-    )  # noqa: E501
+    )
     text = text.replace('name = "turn"', 'name = "turn"\nfrce = [1, 2, 3]')
     path.write_text(text)
     assert main(["check", str(path)]) == EXIT_INVALID_INPUT

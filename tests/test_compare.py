@@ -158,6 +158,11 @@ SHAPES = {
     "tactile grid": pressure.grid([0.0, R, 2 * R], [0.0, R], [[1.0, 2.0, 0.5], [0.0, 3.0, 1.0]]),
     "three points": pressure.points([[0.0, 5 * R], [-4.33 * R, -2.5 * R], [4.33 * R, -2.5 * R]]),
     "skewed points": pressure.points([[0.0, 0.0], [4 * R, 0.0], [0.0, 2 * R]], [1, 2, 3]),
+    # Frames whose origin is not the centre of pressure.
+    "shifted hertz disk": pressure.disk(R, "hertz").shifted(1.5 * R, -0.7 * R),
+    "off-centre points": pressure.points(
+        [[0.0, 0.0], [4 * R, 0.0], [0.0, 2 * R]], [1, 2, 3], centered=False
+    ),
 }
 
 CONSERVATIVE = {

@@ -368,6 +368,72 @@ def test_exact_model_handles_position_dependent_friction_and_combined_surfaces()
     assert model.quadrature_error < 2e-3
 
 
+# -- frames whose origin is not the centre of pressure --------------------------------------------
+
+OFFSET = (0.013, -0.021)  # [m]
+
+MOVED_MODELS = {
+    "ellipsoid": Ellipsoid.from_limit_surface,
+    "fitted-ellipsoid": lambda ls: FittedEllipsoid.from_limit_surface(ls, samples=300),
+    "faceted-ellipsoid": FacetedEllipsoid.from_limit_surface,
+    "cone": Cone.from_limit_surface,
+    "pyramid": lambda ls: Pyramid.from_limit_surface(ls, facets=5),
+    "exact": Exact.from_limit_surface,
+}
+
+
+@pytest.mark.parametrize("name", list(MOVED_MODELS))
+def test_models_of_a_shifted_patch_are_the_models_of_the_centred_patch_moved(skewed, name):
+    # Shifting the patch by d adds d × f to every moment and moves the origin's velocity by
+    # w × (dy, -dx): the model must describe the same physical contact.
+    build = MOVED_MODELS[name]
+    moved_ls = LimitSurface(pressure.points(*SKEWED_POINTS).shifted(*OFFSET), mu=MU, normal_force=N)
+    centred, moved = build(skewed), build(moved_ls)
+    dx, dy = OFFSET
+    loads = np.random.default_rng(8).normal(size=(40, 3)) * [2.0, 2.0, 0.05]
+    moved_loads = loads.copy()
+    moved_loads[:, 2] += dx * loads[:, 1] - dy * loads[:, 0]
+    rtol = 2e-3 if name == "fitted-ellipsoid" else 1e-9
+    np.testing.assert_allclose(moved.safety_factor(moved_loads), centred.safety_factor(loads), rtol)
+    if name in ("ellipsoid", "cone", "pyramid"):
+        assert moved.center == pytest.approx(OFFSET, abs=1e-15)
+        assert moved.rho == pytest.approx(centred.rho, rel=1e-12)
+        assert moved.tilt == pytest.approx(centred.tilt, abs=1e-12)
+    if moved.has_motion and name != "fitted-ellipsoid":
+        twists = centred.motion(loads)
+        expected = twists + np.column_stack(
+            [dy * twists[:, 2], -dx * twists[:, 2], np.zeros(len(twists))]
+        )
+        predicted = moved.motion(moved_loads)
+        # Same direction (Exact scales twists about the frame origin, like LimitSurface).
+        scale = np.array([1.0, 1.0, centred.rho])
+        unit = (predicted * scale) / np.linalg.norm(predicted * scale, axis=1, keepdims=True)
+        ref = (expected * scale) / np.linalg.norm(expected * scale, axis=1, keepdims=True)
+        np.testing.assert_allclose(unit, ref, atol=1e-7)
+
+
+def test_cone_and_pyramid_stay_conservative_off_the_centre_of_pressure():
+    # A linear pressure over a rectangle keeps the rectangle's centroid as origin.
+    field = pressure.from_function(pressure.rectangle(0.02, 0.01), lambda x, y: 1.0 + 50.0 * x)
+    ls = LimitSurface(field, mu=MU, normal_force=N)
+    cone = Cone.from_limit_surface(ls)
+    # Centre of pressure: x_c = ∫ x p dA / ∫ p dA = 50 L² / 12 for p = 1 + 50 x, length L.
+    assert cone.center == pytest.approx((50.0 * 0.02**2 / 12, 0.0), rel=1e-6, abs=1e-12)
+    for model in (cone, Pyramid.from_limit_surface(ls, facets=6)):
+        accuracy = compare(model, ls, n=200)
+        assert accuracy.max_overestimate <= 1e-9
+
+
+def test_pyramid_inequalities_hold_off_the_centre_of_pressure(skewed):
+    moved_ls = LimitSurface(pressure.points(*SKEWED_POINTS).shifted(*OFFSET), mu=MU, normal_force=N)
+    pyramid = Pyramid.from_limit_surface(moved_ls, facets=6)
+    a, b = pyramid.inequalities()
+    loads = np.random.default_rng(9).normal(size=(500, 3)) * [1.0, 1.0, 0.05]
+    safety = pyramid.safety_factor(loads)
+    far = np.abs(safety - 1.0) > 1e-9
+    np.testing.assert_array_equal(np.all(loads @ a.T <= b, axis=1)[far], safety[far] >= 1.0)
+
+
 # -- construction checks -----------------------------------------------------------------------
 
 
@@ -405,3 +471,11 @@ def test_a_million_loads_take_under_half_a_second(disk, build):
             method(loads)
             times.append(time.perf_counter() - start)
         assert np.median(times) < 0.5
+
+
+def test_point_models_must_sit_at_the_centre_of_pressure():
+    field = pressure.points(*SKEWED_POINTS, centered=False)
+    ls = LimitSurface(field, mu=MU, normal_force=N)
+    for build in (PointCone.from_limit_surface, PointPyramid.from_limit_surface):
+        with pytest.raises(InvalidArgumentError, match="not its centre of pressure"):
+            build(ls)

@@ -1,8 +1,10 @@
 """One contract suite over every friction model of fixplan.models (issue §1 and §4).
 
-Each law is checked for every model class on three contacts: a Hertz disk (axisymmetric), a
-10:1 rectangle (flattened surface) and three unequally loaded points (facets and a tilted
-axis, because the load at maximum moment has a force component).
+Each law is checked for every model class on four contacts: a Hertz disk (axisymmetric), a
+10:1 rectangle (flattened surface), three unequally loaded points (facets, and a tilted axis
+because the load at maximum moment has a force component) and the same points in a frame whose
+origin is not their centre of pressure (area models only: a point contact sits at its centre
+of pressure).
 """
 
 import dataclasses
@@ -34,10 +36,13 @@ from fixplan.tolerances import UNSAFE_RTOL
 MU = 0.4
 NORMAL_FORCE = 5.0
 
+SKEWED_XY, SKEWED_WEIGHTS = [[0.0, 0.0], [0.04, 0.0], [0.0, 0.02]], [1, 2, 3]
+
 FIELDS = {
     "hertz-disk": lambda: pressure.disk(0.01, "hertz"),
     "rectangle-10to1": lambda: pressure.rectangle(0.1, 0.01),
-    "three-points": lambda: pressure.points([[0.0, 0.0], [0.04, 0.0], [0.0, 0.02]], [1, 2, 3]),
+    "three-points": lambda: pressure.points(SKEWED_XY, SKEWED_WEIGHTS),
+    "off-centre-points": lambda: pressure.points(SKEWED_XY, SKEWED_WEIGHTS, centered=False),
 }
 
 FACTORIES = {
@@ -57,7 +62,11 @@ FACTORIES = {
     "exact": lambda ls: Exact.from_limit_surface(ls, order=4),
 }
 
-CASES = [(m, f) for m in FACTORIES for f in FIELDS]
+POINT_MODELS = ("point-cone", "point-pyramid-4-inscribed", "point-pyramid-8-circumscribed")
+
+CASES = [
+    (m, f) for m in FACTORIES for f in FIELDS if not (m in POINT_MODELS and f.startswith("off"))
+]
 
 #: A load component in units of the largest force or moment, on a grid of 1e-3.
 COMPONENT = st.integers(-1000, 1000).map(lambda k: k / 1000)
@@ -155,7 +164,7 @@ def test_model_is_convex(name, field, a, b):
 
 
 @pytest.mark.parametrize(("name", "field"), CASES)
-@settings(max_examples=15, deadline=None)
+@settings(max_examples=8, deadline=None)
 @given(scale=st.floats(0.05, 20.0))
 def test_model_scales_with_the_normal_force(name, field, scale):
     m = model(name, field)
@@ -176,18 +185,22 @@ def test_model_scales_with_mu(name, field):
     np.testing.assert_allclose(doubled.safety_factor(2 * loads), base.safety_factor(loads), 1e-9)
 
 
-@pytest.mark.parametrize(("name", "field"), CASES)
+@pytest.mark.parametrize(
+    ("name", "field"), [c for c in CASES if model(c[0], "hertz-disk").conservative]
+)
 def test_conservative_models_lie_inside_the_exact_surface(name, field):
-    m = model(name, field)
-    accuracy = compare(m, surface(field), n=400)
-    if m.conservative:
-        assert accuracy.max_overestimate <= UNSAFE_RTOL
-        assert accuracy.unsafe_fraction == 0.0
+    accuracy = compare(model(name, field), surface(field), n=400)
+    assert accuracy.max_overestimate <= UNSAFE_RTOL
+    assert accuracy.unsafe_fraction == 0.0
 
 
 @pytest.mark.parametrize("name", [n for n in FACTORIES if not model(n, "hertz-disk").conservative])
 def test_models_not_flagged_conservative_do_overestimate_somewhere(name):
-    worst = max(compare(model(name, f), surface(f), n=400).max_overestimate for f in FIELDS)
+    worst = max(
+        compare(model(name, f), surface(f), n=400).max_overestimate
+        for f in FIELDS
+        if (name, f) in CASES
+    )
     assert worst > UNSAFE_RTOL
 
 
@@ -243,9 +256,12 @@ def test_motion_follows_normality_or_is_refused(name, field):
             m.motion(loads[0])
         return
     twists = m.motion(loads)
-    rho = m.rho if m.torsion else 0.0
-    scaled = twists * np.array([1.0, 1.0, rho])
-    np.testing.assert_allclose(np.linalg.norm(scaled, axis=1), 1.0, rtol=1e-12)
+    # Unit twist about the centre of pressure c: (vx - cy w, vy + cx w, rho w).
+    (cx, cy), rho = m.center, (m.rho if m.torsion else 0.0)
+    about_center = twists + np.column_stack(
+        [-cy * twists[:, 2], cx * twists[:, 2], (rho - 1.0) * twists[:, 2]]
+    )
+    np.testing.assert_allclose(np.linalg.norm(about_center, axis=1), 1.0, rtol=1e-12)
     # Maximum power: the twist at a boundary load L makes V·L the largest over the set.
     boundary = loads * m.safety_factor(loads)[:, None]
     others = loads_for(m, 400, seed=7)
@@ -277,9 +293,9 @@ def test_inner_pyramid_lies_inside_cone_inside_outer_pyramid(field, facets):
     assert np.all(s_inner <= s_cone * (1 + 1e-12))
     assert np.all(s_cone <= s_outer * (1 + 1e-12))
     points = [
-        PointPyramid.from_limit_surface(ls, facets=facets),
-        PointCone.from_limit_surface(ls),
-        PointPyramid.from_limit_surface(ls, facets=facets, inscribed=False),
+        PointPyramid(mu=cone.mu, facets=facets),
+        PointCone(mu=cone.mu),
+        PointPyramid(mu=cone.mu, facets=facets, inscribed=False),
     ]
     forces = loads[:, :2]
     s_point = [p.safety_factor(forces) for p in points]

@@ -1,0 +1,614 @@
+"""A plan's report: a self-contained folder with Markdown, HTML, JSON and PNG figures.
+
+:func:`write_report` writes into a folder
+
+- ``report.md`` and ``report.html``: the same content (the HTML opens in a browser with its
+  figures): a header of versions, model choices and the problem file's SHA-256, the status and
+  objective, active forces, safety factors per load case, the impending motions in words, the
+  infeasibility certificate when there is one, and the figures;
+- ``plan.json``: :meth:`Plan.as_dict` with sorted keys;
+- PNG figures (:mod:`fixplan.figures`): ``layout.png``, ``safety-factors.png``,
+  ``contact-NN-NAME.png`` per loaded area contact and ``contact-set.png``.
+
+The report is built once as a list of blocks (headings, paragraphs, tables, lists, images) and
+rendered to both formats from them. Nothing in it depends on the time or the machine's paths,
+so two reports of the same problem file and plan are byte-identical and diff cleanly.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import os
+import re
+import warnings
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
+
+import cvxpy
+import numpy as np
+
+import fixplan
+from fixplan import figures
+from fixplan.contact_surface import COMPONENTS, ContactSetSurface
+from fixplan.errors import FixplanError, InvalidArgumentError
+from fixplan.plan import Plan
+from fixplan.planner import Planner
+from fixplan.problem import FIXED_FORCE_OBJECTIVES, PASSIVE_ROLES, Problem
+from fixplan.problem_file import ProblemFile
+
+#: A contact whose normal force is at most this fraction of the largest normal force of its load
+#: case carries no load: its section figure is skipped (its friction set is a point).
+UNLOADED_RTOL = 1e-9
+#: Points per section of the contact-set surface (each is one conic solve).
+CONTACT_SET_POINTS = 72
+#: Printed contact forces and moments below this fraction of the largest normal force of their
+#: load case (moments: times the planner's length scale) are solver rounding and printed as 0.
+PRINT_RTOL = 1e-9
+#: Equilibrium residuals below this are printed as ``below RESIDUAL_FLOOR`` (their digits are
+#: rounding noise that differs between machines).
+RESIDUAL_FLOOR = 1e-12
+
+_SOLVER_PACKAGES = {"CLARABEL": "clarabel", "OSQP": "osqp", "SCS": "scs"}
+_MARKDOWN_SPECIAL = re.compile(r"([\\`*_<>|])")
+_MARKDOWN_LINK = re.compile(r"([\[\]])")
+_CSS = """\
+body { font-family: sans-serif; max-width: 70em; margin: 2em auto; padding: 0 1em; color: #222; }
+table { border-collapse: collapse; margin: 0.5em 0 1em; }
+th, td { border: 1px solid #bbb; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }
+th { background: #eee; }
+code { font-size: 0.9em; background: #f4f4f4; padding: 0 0.2em; }
+figure { margin: 1em 0; }
+figure img { max-width: 100%; border: 1px solid #ddd; }
+figcaption { font-size: 0.9em; color: #444; }
+"""
+
+
+class ReportError(FixplanError, OSError):
+    """The report folder cannot be created or written."""
+
+
+# -- document blocks ----------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class _Code:
+    """Inline code (verbatim text)."""
+
+    text: str
+
+
+#: Inline text: plain strings and code spans.
+_Inline = tuple[str | _Code, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class _Heading:
+    level: int
+    text: _Inline
+
+
+@dataclass(frozen=True, slots=True)
+class _Paragraph:
+    text: _Inline
+
+
+@dataclass(frozen=True, slots=True)
+class _Table:
+    header: tuple[str, ...]
+    rows: tuple[tuple[_Inline, ...], ...]
+
+
+@dataclass(frozen=True, slots=True)
+class _List:
+    items: tuple[_Inline, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class _Image:
+    file: str
+    alt: str
+    caption: _Inline
+
+
+_Block = _Heading | _Paragraph | _Table | _List | _Image
+
+
+def _text(*parts: str | _Code) -> _Inline:
+    return tuple(parts)
+
+
+def _markdown_inline(text: _Inline, *, in_table: bool = False) -> str:
+    """Markdown of ``text``; in a table cell ``|`` is escaped inside code spans too (GFM)."""
+    out = []
+    for part in text:
+        if isinstance(part, _Code):
+            body = part.text.replace("|", "\\|") if in_table else part.text
+            fence, pad = ("``", " ") if "`" in body else ("`", "")
+            out.append(f"{fence}{pad}{body}{pad}{fence}")
+        else:
+            out.append(_markdown_escape(part))
+    return "".join(out).replace("\n", " ")
+
+
+def _markdown_escape(text: str) -> str:
+    """``text`` with Markdown's emphasis, code, HTML and table characters escaped; brackets only
+    where they could form a link (so units read ``[N]``)."""
+    text = _MARKDOWN_SPECIAL.sub(r"\\\1", text)
+    return _MARKDOWN_LINK.sub(r"\\\1", text) if "](" in text else text
+
+
+def _html_inline(text: _Inline) -> str:
+    return "".join(
+        f"<code>{html.escape(p.text)}</code>" if isinstance(p, _Code) else html.escape(p)
+        for p in text
+    )
+
+
+def _to_markdown(blocks: Sequence[_Block]) -> str:
+    chunks = []
+    for block in blocks:
+        if isinstance(block, _Heading):
+            chunks.append("#" * block.level + " " + _markdown_inline(block.text))
+        elif isinstance(block, _Paragraph):
+            chunks.append(_markdown_inline(block.text))
+        elif isinstance(block, _List):
+            chunks.append("\n".join("- " + _markdown_inline(item) for item in block.items))
+        elif isinstance(block, _Table):
+            header = [_markdown_inline((h,), in_table=True) for h in block.header]
+            lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+            for row in block.rows:
+                cells = [_markdown_inline(cell, in_table=True) for cell in row]
+                lines.append("| " + " | ".join(cells) + " |")
+            chunks.append("\n".join(lines))
+        else:
+            alt = _MARKDOWN_LINK.sub(r"\\\1", _markdown_escape(block.alt))
+            chunks.append(f"![{alt}]({block.file})\n\n{_markdown_inline(block.caption)}")
+    return "\n\n".join(chunks) + "\n"
+
+
+def _to_html(blocks: Sequence[_Block], title: str) -> str:
+    body = []
+    for block in blocks:
+        if isinstance(block, _Heading):
+            level = block.level
+            body.append(f"<h{level}>{_html_inline(block.text)}</h{level}>")
+        elif isinstance(block, _Paragraph):
+            body.append(f"<p>{_html_inline(block.text)}</p>")
+        elif isinstance(block, _List):
+            items = "".join(f"<li>{_html_inline(item)}</li>" for item in block.items)
+            body.append(f"<ul>{items}</ul>")
+        elif isinstance(block, _Table):
+            header = "".join(f"<th>{html.escape(h)}</th>" for h in block.header)
+            rows = "\n".join(
+                "<tr>" + "".join(f"<td>{_html_inline(cell)}</td>" for cell in row) + "</tr>"
+                for row in block.rows
+            )
+            body.append(
+                f"<table>\n<thead><tr>{header}</tr></thead>\n<tbody>\n{rows}\n</tbody>\n</table>"
+            )
+        else:
+            body.append(
+                f'<figure><img src="{html.escape(block.file)}" alt="{html.escape(block.alt)}">'
+                f"<figcaption>{_html_inline(block.caption)}</figcaption></figure>"
+            )
+    return (
+        '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
+        f"<title>{html.escape(title)}</title>\n<style>\n{_CSS}</style>\n</head>\n<body>\n"
+        + "\n".join(body)
+        + "\n</body>\n</html>\n"
+    )
+
+
+# -- numbers and names --------------------------------------------------------------------------
+
+
+def _num(value: float | None, digits: int = 5) -> str:
+    """One format for every number of the report (``∞`` for infinity, ``-0`` as ``0``)."""
+    if value is None:
+        return "n/a"
+    value = float(value)
+    if np.isnan(value):
+        return "nan"
+    if np.isinf(value):
+        return "∞" if value > 0 else "-∞"
+    return f"{value + 0.0:.{digits}g}"
+
+
+def _residual(value: float | None) -> str:
+    if value is not None and abs(value) < RESIDUAL_FLOOR:
+        return f"below {RESIDUAL_FLOOR:g}"
+    return _num(value, 3)
+
+
+def _slug(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_-]+", "-", name).strip("-") or "contact"
+
+
+def _package_version(package: str) -> str:
+    try:
+        return version(package)
+    except PackageNotFoundError:
+        return "not installed"
+
+
+def _solver_text(solvers: str) -> str:
+    names = [s for s in (part.strip() for part in solvers.split(",")) if s]
+    return ", ".join(
+        f"{name} {_package_version(_SOLVER_PACKAGES.get(name, name.lower()))}" for name in names
+    )
+
+
+# -- defaults -----------------------------------------------------------------------------------
+
+
+def default_sliding_subspace(problem: Problem) -> tuple[str, str, str]:
+    """The wrench components in which a fixtured part slides on its supports.
+
+    The world axis ``k`` most aligned with the supports' normals (``"support"`` contacts; all
+    passive contacts if there are none; all contacts if none are passive) is the axis the part
+    rests along; it slides in the plane across it: the two forces across ``k`` and the moment
+    about ``k``. Supports along ``±z`` give ``("fx", "fy", "mz")``.
+    """
+    chosen = [c for c in problem.contacts if c.role == "support"]
+    chosen = chosen or [c for c in problem.contacts if c.role in PASSIVE_ROLES]
+    chosen = chosen or list(problem.contacts)
+    k = int(np.argmax(np.abs([c.normal for c in chosen]).sum(axis=0)))
+    forces = [f"f{axis}" for i, axis in enumerate("xyz") if i != k]
+    return (forces[0], forces[1], f"m{'xyz'[k]}")
+
+
+# -- figures ------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class _Figure:
+    file: str
+    alt: str
+    caption: str
+
+
+class _Writer:
+    """Writes the files of one report and keeps the list of what it wrote."""
+
+    def __init__(self, directory: Path):
+        self.directory = directory
+        self.written: list[Path] = []
+
+    def write(self, name: str, content: bytes) -> None:
+        path = self.directory / name
+        try:
+            path.write_bytes(content)
+        except OSError as exc:
+            raise ReportError(f"cannot write {path}: {exc.strerror or exc}") from exc
+        self.written.append(path)
+
+    def figure(self, name: str, draw: Callable[[], object]) -> None:
+        path = self.directory / name
+        try:
+            figures.save_png(draw(), path)
+        except OSError as exc:
+            raise ReportError(f"cannot write {path}: {exc.strerror or exc}") from exc
+        self.written.append(path)
+
+
+def _state_text(plan: Plan) -> str:
+    """When the plan's contact wrenches hold."""
+    if plan.objective in FIXED_FORCE_OBJECTIVES:
+        return "at impending slip (the task load times its safety factor)"
+    return "at the task load"
+
+
+def _contact_set_figure(problem, plan, j, subspace, writer, figures_out, notes) -> None:
+    """The fixture's limit surface at the normal forces of load case ``j``, or a note why not."""
+    select = np.array([np.eye(6)[COMPONENTS.index(c)] for c in subspace])
+    friction = sum(
+        select @ contact.wrench_basis()[:, 1:] @ plan.contact_wrenches[i, j, 1:]
+        for i, contact in enumerate(problem.contacts)
+    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            surface = ContactSetSurface(problem.contacts, plan.normal_forces[:, j], subspace)
+            writer.figure(
+                "contact-set.png",
+                lambda: figures.contact_set_figure(surface, load=friction, n=CONTACT_SET_POINTS),
+            )
+        except (FixplanError, cvxpy.error.SolverError) as exc:
+            notes.append(f"The contact-set limit surface was not drawn: {exc}.")
+            return
+    inaccurate = [w for w in caught if "inaccurate" in str(w.message)]
+    for w in caught:
+        if w not in inaccurate:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    caption = (
+        f"Limit surface of all contacts together (Minkowski sum of their friction sets) in the "
+        f"sliding subspace ({', '.join(subspace)}) at the normal forces of load case "
+        f"'{plan.load_names[j]}'; the dot is the plan's friction resultant in that subspace."
+    )
+    if inaccurate:
+        caption += f" The solver flagged {len(inaccurate)} section points as possibly inaccurate."
+    figures_out.append(_Figure("contact-set.png", "contact-set limit surface", caption))
+
+
+def _draw_figures(problem, plan, planner, load, subspace, writer) -> tuple[list, list]:
+    """Write the figures; returns their descriptions and notes on those skipped."""
+    out, notes = [], []
+    j = plan.load_names.index(load)
+    writer.figure("layout.png", lambda: figures.layout_figure(problem, plan, load))
+    out.append(
+        _Figure(
+            "layout.png",
+            "contact layout",
+            f"Contacts, their normals and (black) the contact forces of load case '{load}' "
+            f"{_state_text(plan)}; green: the task force."
+            if plan.contact_wrenches is not None
+            else f"Contacts and their normals; green: the task force of load case '{load}'. "
+            "The plan has no contact forces.",
+        )
+    )
+    if plan.safety_factors:
+        writer.figure("safety-factors.png", lambda: figures.safety_figure(plan))
+        out.append(
+            _Figure("safety-factors.png", "safety factors", "Safety factor of every load case.")
+        )
+    if plan.contact_wrenches is None:
+        notes.append("Force figures were skipped: the plan has no contact forces.")
+        return out, notes
+    wrenches = plan.contact_wrenches[:, j]
+    largest = float(np.max(wrenches[:, 0]))
+    for i, (contact, model) in enumerate(zip(problem.contacts, planner.models, strict=True)):
+        if not model.torsion:
+            continue
+        if wrenches[i, 0] <= UNLOADED_RTOL * largest:
+            notes.append(f"Contact '{contact.name}' carries no normal force in load case '{load}'.")
+            continue
+        name = f"contact-{i:02d}-{_slug(contact.name)}.png"
+        writer.figure(
+            name,
+            lambda i=i, contact=contact, model=model: figures.contact_section_figure(
+                contact, model, wrenches[i, 1:], wrenches[i, 0], load_name=load
+            ),
+        )
+        out.append(
+            _Figure(
+                name,
+                f"friction sections of contact {contact.name}",
+                f"Load of contact '{contact.name}' in load case '{load}' inside the central "
+                f"sections of its friction set ({type(model).__name__}) at its normal force, "
+                "normalised as in the paper (forces by mu N, the moment by mu rho N); the cross "
+                "is where the load's ray leaves the set.",
+            )
+        )
+    _contact_set_figure(problem, plan, j, subspace, writer, out, notes)
+    return out, notes
+
+
+# -- the document -------------------------------------------------------------------------------
+
+
+def _header(problem_file: ProblemFile, plan: Plan, planner: Planner, subspace) -> list[_Block]:
+    rows = [
+        ("fixplan", _text(fixplan.__version__)),
+        ("cvxpy", _text(cvxpy.__version__)),
+        ("solver requested", _text(_solver_text(planner.solver))),
+        ("solver used", _text(_solver_text(plan.solver) or "none")),
+        ("problem", _text(problem_file.name)),
+        ("kind", _text(problem_file.kind)),
+        ("problem file", _text(_Code(problem_file.path.name))),
+        ("problem file SHA-256", _text(_Code(problem_file.sha256))),
+        ("model override", _text(problem_file.model_override or "none")),
+        ("objective", _text(plan.objective)),
+        ("sliding subspace", _text(", ".join(subspace))),
+    ]
+    models = [
+        (_text(c.name), _text(c.role), _text(_Code(repr(m))))
+        for c, m in zip(planner.problem.contacts, planner.models, strict=True)
+    ]
+    return [
+        _Heading(1, _text(f"fixplan report: {problem_file.name}")),
+        _Table(("item", "value"), tuple((_text(k), v) for k, v in rows)),
+        _Heading(2, _text("Friction models")),
+        _Paragraph(_text("The model of every contact at unit normal force.")),
+        _Table(("contact", "role", "model"), tuple(models)),
+    ]
+
+
+def _result(plan: Plan, problem: Problem) -> list[_Block]:
+    unit = " (safety factor)" if plan.objective in FIXED_FORCE_OBJECTIVES else " N"
+    value = "none" if plan.objective_value is None else _num(plan.objective_value) + unit
+    blocks: list[_Block] = [
+        _Heading(2, _text("Result")),
+        _Table(
+            ("item", "value"),
+            (
+                (_text("status"), _text(plan.status)),
+                (_text("objective value"), _text(value)),
+                (_text("equilibrium residual (relative)"), _text(_residual(plan.residual))),
+            ),
+        ),
+    ]
+    if plan.warnings:
+        blocks += [_Paragraph(_text("Warnings:")), _List(tuple(_text(w) for w in plan.warnings))]
+    if plan.certificate is not None:
+        blocks += [
+            _Heading(2, _text("Infeasibility certificate")),
+            _Paragraph(_text(plan.certificate)),
+        ]
+        if plan.infeasible_motions:
+            blocks.append(
+                _Table(
+                    ("load case", "unresisted motion"),
+                    tuple(
+                        (_text(name), _text(m.describe()))
+                        for name, m in plan.infeasible_motions.items()
+                    ),
+                )
+            )
+    if plan.forces:
+        roles = {c.name: c.role for c in problem.contacts}
+        rows = []
+        for name, force in plan.forces.items():
+            if np.ndim(force) == 0:
+                text = _num(force)
+            else:
+                text = ", ".join(
+                    f"{case}: {_num(f)}" for case, f in zip(plan.load_names, force, strict=True)
+                )
+            rows.append((_text(name), _text(roles[name]), _text(text)))
+        blocks += [
+            _Heading(2, _text("Active forces")),
+            _Table(("contact", "role", "normal force [N]"), tuple(rows)),
+        ]
+    if plan.safety_factors:
+        rows = tuple(
+            (_text(name), _text(_num(s)), _text("yes" if plan.held.get(name) else "no"))
+            for name, s in plan.safety_factors.items()
+        )
+        blocks += [
+            _Heading(2, _text("Safety factors")),
+            _Paragraph(
+                _text(
+                    "The largest factor by which each task load (not gravity) can be scaled "
+                    "while the contacts hold it with these active forces."
+                )
+            ),
+            _Table(("load case", "safety factor", "held"), rows),
+            _Paragraph(
+                _text(
+                    f"Critical load case: {plan.critical_load}; its most used contact: "
+                    f"{plan.critical_contact}."
+                )
+            ),
+        ]
+    if plan.motions:
+        rows = tuple(
+            (_text(name), _text("no limit found" if m is None else m.describe()))
+            for name, m in plan.motions.items()
+        )
+        blocks += [
+            _Heading(2, _text("Impending motion")),
+            _Paragraph(_text("How the body starts to slide when a task load exceeds its margin.")),
+            _Table(("load case", "motion"), rows),
+        ]
+    return blocks
+
+
+def _wrench_table(plan: Plan, j: int, length_scale: float) -> list[_Block]:
+    wrenches = plan.contact_wrenches[:, j]
+    noise = PRINT_RTOL * float(np.max(np.abs(wrenches[:, 0])))
+    wrenches = np.where(
+        np.abs(wrenches) < noise * np.array([1.0, 1.0, 1.0, length_scale]), 0.0, wrenches
+    )
+    rows = []
+    for i, name in enumerate(plan.contact_names):
+        fn, ft1, ft2, mn = wrenches[i]
+        used = "n/a" if plan.utilisation is None else _num(plan.utilisation[i, j], 3)
+        rows.append(tuple(_text(x) for x in (name, _num(fn), _num(ft1), _num(ft2), _num(mn), used)))
+    load = plan.load_names[j]
+    return [
+        _Heading(2, _text(f"Contact wrenches, load case {load}")),
+        _Paragraph(
+            _text(
+                f"Each contact's wrench on the body in its own frame (normal, tangents t1, t2, "
+                f"moment about the normal), {_state_text(plan)}. Friction used: the fraction of "
+                "the contact's friction set its load uses at impending slip."
+                + (
+                    ""
+                    if plan.objective in FIXED_FORCE_OBJECTIVES
+                    else " Friction in a fixture with more contacts than needed is statically "
+                    "indeterminate: this is the distribution the planner found."
+                )
+            )
+        ),
+        _Table(
+            ("contact", "fn [N]", "ft1 [N]", "ft2 [N]", "mn [N m]", "friction used"), tuple(rows)
+        ),
+    ]
+
+
+def _figure_case(plan: Plan) -> tuple[str, str | None]:
+    """The load case the figures show, and a note when it is not the critical one."""
+    if plan.critical_load is not None:
+        return plan.critical_load, None
+    if plan.infeasible_motions:
+        load = next(iter(plan.infeasible_motions))
+        return load, f"The figures show load case '{load}', which cannot be held."
+    load = plan.load_names[0]
+    return load, f"No critical load case is known; the figures show load case '{load}'."
+
+
+def write_report(
+    directory: str | os.PathLike[str],
+    problem_file: ProblemFile,
+    plan: Plan,
+    planner: Planner,
+    *,
+    sliding_subspace: Sequence[str] | None = None,
+) -> list[Path]:
+    """Write the report of ``plan`` into ``directory`` (see the module docstring).
+
+    The folder is created if needed; the report's own files are overwritten and any other file
+    in it is left alone. Figures that need contact forces are skipped for a plan without them
+    (infeasible, solver error), and the report says so.
+
+    Parameters
+    ----------
+    directory : str or path-like
+        The report folder.
+    problem_file : ProblemFile
+        The problem as read from its file (name, kind, SHA-256, model override).
+    plan : Plan
+        The plan of ``planner.problem``.
+    planner : Planner
+        The planner that produced ``plan`` (its friction models and solver).
+    sliding_subspace : sequence of str, optional
+        Wrench components of the contact-set surface figure; default
+        :func:`default_sliding_subspace`.
+
+    Returns
+    -------
+    list of Path
+        The files written, in the order written.
+
+    Raises
+    ------
+    ReportError
+        The folder cannot be created or a file cannot be written.
+    InvalidArgumentError
+        ``sliding_subspace`` names unknown components.
+    """
+    problem = planner.problem
+    subspace = (
+        default_sliding_subspace(problem) if sliding_subspace is None else tuple(sliding_subspace)
+    )
+    if len(subspace) < 2 or len(set(subspace)) != len(subspace) or set(subspace) - set(COMPONENTS):
+        raise InvalidArgumentError(
+            f"sliding_subspace must name at least two distinct components of "
+            f"{', '.join(COMPONENTS)}; got {list(subspace)}"
+        )
+    directory = Path(directory)
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ReportError(f"cannot create the report folder {directory}: {exc}") from exc
+    writer = _Writer(directory)
+    document = json.dumps(plan.as_dict(), indent=2, sort_keys=True)
+    writer.write("plan.json", (document + "\n").encode("utf-8"))
+    load, case_note = _figure_case(plan)
+    drawn, notes = _draw_figures(problem, plan, planner, load, subspace, writer)
+    blocks = _header(problem_file, plan, planner, subspace) + _result(plan, problem)
+    if plan.contact_wrenches is not None:
+        blocks += _wrench_table(plan, plan.load_names.index(load), planner.length_scale)
+    blocks.append(_Heading(2, _text("Figures")))
+    if case_note:
+        blocks.append(_Paragraph(_text(case_note)))
+    blocks += [_Image(f.file, f.alt, _text(f.caption)) for f in drawn]
+    if notes:
+        blocks.append(_List(tuple(_text(note) for note in notes)))
+    title = f"fixplan report: {problem_file.name}"
+    writer.write("report.md", _to_markdown(blocks).encode("utf-8"))
+    writer.write("report.html", _to_html(blocks, title).encode("utf-8"))
+    return writer.written
