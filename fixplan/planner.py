@@ -26,6 +26,7 @@ import cvxpy as cp
 import numpy as np
 
 from fixplan.contact_models import contact_model
+from fixplan.direct_solve import DirectSolver
 from fixplan.errors import FixplanError, InvalidArgumentError
 from fixplan.plan import Plan
 from fixplan.problem import FIXED_FORCE_OBJECTIVES, PASSIVE_ROLES, Load, Problem
@@ -46,6 +47,9 @@ _SOLVER_OPTIONS = {
     "SCS": {"eps": 1e-9, "max_iters": 200_000},
     "OSQP": {"eps_abs": 1e-8, "eps_rel": 1e-8, "max_iter": 50_000, "polish": True},
 }
+#: Clarabel settings of the direct re-solves: iterative refinement of the KKT solves is off
+#: (a third of the time on the fixture benchmark); every answer is verified in numpy anyway.
+_DIRECT_OPTIONS = {**_SOLVER_OPTIONS["CLARABEL"], "iterative_refinement_enable": False}
 _STATUS = {
     cp.OPTIMAL: "optimal",
     cp.OPTIMAL_INACCURATE: "inaccurate",
@@ -106,6 +110,8 @@ class Planner:
         spread = np.linalg.norm(positions - problem.body.center_of_mass, axis=1)
         self.length_scale = float(max(spread.max(), 1e-3))
         self._built: dict[str, _Built] = {}
+        self._direct: dict[str, DirectSolver | None] = {}
+        self._solves: dict[str, int] = {}
 
     # -- building -----------------------------------------------------------------------------
 
@@ -238,7 +244,7 @@ class Planner:
             for note in problems:
                 warnings.warn(note, stacklevel=2)
         forces = self._active_forces(normal)
-        analysis = result
+        analysis = result if objective in FIXED_FORCE_OBJECTIVES else None
         if objective not in FIXED_FORCE_OBJECTIVES and analyse and status == "optimal":
             fixed = {i: (f if np.ndim(f) == 0 else np.asarray(f)) for i, f in self._indexed(forces)}
             analysis = self._run("check", wrenches, fixed, progress)
@@ -304,9 +310,14 @@ class Planner:
             parameter.value = (
                 value if parameter.ndim == 0 else np.broadcast_to(value, parameter.shape)
             )
+        direct = self._direct_result(objective, built)
+        if direct is not None:
+            return direct
         notes = []
         solver = self.solver
         status = self._call(built.problem, solver)
+        if status == "optimal":
+            self._prepare_direct(objective, built)
         if status in ("solver-error", "inaccurate"):
             fallback = _FALLBACK[solver]
             notes.append(f"{solver} returned {status}; retried with {fallback}")
@@ -321,6 +332,40 @@ class Planner:
             dual = built.balance.dual_value
             result["dual"] = None if dual is None else np.asarray(dual, dtype=float)
         return result
+
+    def _direct_result(self, objective: str, built: _Built) -> dict | None:
+        """Solve straight through Clarabel when a direct solver exists for ``objective``.
+
+        ``None`` sends the solve through cvxpy (see :meth:`_prepare_direct`).
+        """
+        direct = self._direct.get(objective)
+        values = None if direct is None else direct.solve()
+        if values is None:
+            return None
+        for variable in built.problem.variables():
+            variable.save_value(values[variable.id])
+        return {
+            "status": "optimal",
+            "solver": "CLARABEL (direct)",
+            "warnings": [],
+            "normal": np.asarray(built.normal.value, dtype=float),
+            "friction": np.asarray(built.friction.value, dtype=float),
+            "scale": np.asarray(built.scale.value, dtype=float).ravel(),
+        }
+
+    def _prepare_direct(self, objective: str, built: _Built) -> None:
+        """Build the direct solver of a force objective after its second cvxpy solve.
+
+        It is checked against that solve's answer (same parameters); one-off problems never
+        pay for it.
+        """
+        if self.solver != "CLARABEL" or objective in FIXED_FORCE_OBJECTIVES:
+            return
+        if objective in self._direct or built.problem.status != cp.OPTIMAL:
+            return
+        self._solves[objective] = self._solves.get(objective, 0) + 1
+        if self._solves[objective] >= 2:
+            self._direct[objective] = DirectSolver.create(built.problem, _DIRECT_OPTIONS)
 
     @staticmethod
     def _call(problem: cp.Problem, solver: str) -> str:

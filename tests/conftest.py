@@ -100,9 +100,9 @@ def surface(request) -> LimitSurface:
     return SURFACES[request.param]()
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture
 def rng() -> np.random.Generator:
-    """A seeded generator (tests stay deterministic)."""
+    """A freshly seeded generator for each test (results do not depend on test order)."""
     return np.random.default_rng(20240607)
 
 

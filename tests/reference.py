@@ -328,7 +328,7 @@ def _posed(local, twist, angle, offset):
 
 
 @cache
-def _tanh_sinh(step: float = 1.0 / 32.0, reach: float = 3.6) -> tuple[np.ndarray, np.ndarray]:
+def _tanh_sinh(step: float = 1.0 / 16.0, reach: float = 3.6) -> tuple[np.ndarray, np.ndarray]:
     """Tanh-sinh nodes in (0, 1) and weights (sum 1)."""
     k = np.arange(-int(reach / step), int(reach / step) + 1) * step
     arg = 0.5 * np.pi * np.sinh(k)
