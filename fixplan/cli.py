@@ -286,6 +286,11 @@ def _surface_models(surface):
     }
 
 
+def _percent(fraction: float) -> float:
+    """``fraction`` in percent rounded to 0.01, without a negative zero."""
+    return float(np.round(100.0 * fraction, 2)) + 0.0
+
+
 def _run_surface(args: argparse.Namespace) -> int:
     from fixplan.compare import compare
     from fixplan.limit_surface import LimitSurface
@@ -329,9 +334,9 @@ def _run_surface(args: argparse.Namespace) -> int:
     print(f"  {'model':24s} {'max over':>9s} {'max under':>10s} {'unsafe':>7s} {'motion':>9s}")
     for name, acc in accuracy.items():
         angle = "-" if acc.max_motion_angle is None else f"{np.degrees(acc.max_motion_angle):.2f}°"
+        over, under = (_percent(acc.max_overestimate), _percent(acc.max_underestimate))
         print(
-            f"  {name:24s} {100 * acc.max_overestimate:8.2f}% {100 * acc.max_underestimate:9.2f}%"
-            f" {100 * acc.unsafe_fraction:6.1f}% {angle:>9s}"
+            f"  {name:24s} {over:8.2f}% {under:9.2f}% {100 * acc.unsafe_fraction:6.1f}% {angle:>9s}"
         )
     return EXIT_OK
 

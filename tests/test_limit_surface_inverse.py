@@ -312,7 +312,7 @@ def test_facets_of_a_combined_surface_are_those_of_its_point_supports():
             assert _angles(surface, motion, twist) <= FACET_RTOL
 
 
-@pytest.mark.parametrize("distance", [1e-2, 1e-3, 3e-4, 1e-4, 1e-5])
+@pytest.mark.parametrize("distance", [1e-2, 1e-3, 1e-4])
 @pytest.mark.parametrize("name", sorted(POINT_SETS))
 def test_loads_near_but_off_a_facet_are_not_taken_for_facet_loads(name, distance):
     """CORs at ``distance`` patch sizes from a support point: the load is on the surface next
@@ -329,28 +329,29 @@ def test_loads_near_but_off_a_facet_are_not_taken_for_facet_loads(name, distance
 
 
 def _certify_points(xy, weights, mu, normal_force, load, motion, safety):
-    """Excess of the friction needed by ``safety * load`` over the limit of the stationary point
-    under ``motion`` (<= 0 when held) and the relative residual of the other points' forces."""
+    """Check that ``safety * load`` is carried by the points under ``motion``.
+
+    Every moving point slides at its friction limit along its velocity; what is left must be a
+    force at the stationary point (if any). Returns the index of the stationary point (or
+    ``None``), the force it must carry over its limit (<= 1 when held) and the relative residual
+    that no point can carry (0 up to rounding).
+    """
     limits = np.array([_limit(xy, weights, mu, normal_force, k) for k in range(len(xy))])
     velocity = np.column_stack([motion[0] - motion[2] * xy[:, 1], motion[1] + motion[2] * xy[:, 0]])
     speed = np.hypot(velocity[:, 0], velocity[:, 1])
     scale = math.hypot(motion[0], motion[1]) + abs(motion[2]) * np.max(np.abs(xy))
     still = speed <= 1e-9 * scale
-    forces = np.where(
-        still[:, None], 0.0, limits[:, None] * velocity / np.where(still, 1, speed)[:, None]
-    )
-    sliding = np.array(
-        [forces[:, 0].sum(), forces[:, 1].sum(), (xy[:, 0] * forces[:, 1] - xy[:, 1] * forces[:, 0]).sum()]
-    )  # fmt: skip
-    residual = safety * load - sliding
+    forces = limits[:, None] * velocity / np.where(still, np.inf, speed)[:, None]
+    moments = xy[:, 0] * forces[:, 1] - xy[:, 1] * forces[:, 0]
+    residual = safety * load - np.array([forces[:, 0].sum(), forces[:, 1].sum(), moments.sum()])
     size = np.max(np.abs(xy))
     norm = np.linalg.norm(safety * load * [1, 1, 1 / size])
     if not np.any(still):
-        return -1.0, np.linalg.norm(residual * [1, 1, 1 / size]) / norm
+        return None, 0.0, np.linalg.norm(residual * [1, 1, 1 / size]) / norm
     k = int(np.flatnonzero(still)[0])
     fx, fy = residual[:2]
     moment_error = abs(residual[2] - (xy[k, 0] * fy - xy[k, 1] * fx)) / size / norm
-    return math.hypot(fx, fy) / limits[k] - 1.0, moment_error
+    return k, math.hypot(fx, fy) / limits[k], moment_error
 
 
 @pytest.mark.parametrize("name", sorted(POINT_SETS))
@@ -363,10 +364,10 @@ def test_random_loads_on_point_supports_have_a_friction_certificate(name, rng):
     motions, safety = surface.motion_and_safety_factor(loads)
     on_facets = 0
     for load, motion, s in zip(loads, motions, safety, strict=True):
-        excess, residual = _certify_points(xy, weights, mu, normal_force, load, motion, s)
-        assert excess <= 1e-9
+        point, carried, residual = _certify_points(xy, weights, mu, normal_force, load, motion, s)
+        assert carried <= 1.0 + 1e-9
         assert residual <= SAFETY_RTOL
-        on_facets += excess > -1.0
+        on_facets += point is not None
     assert on_facets > 0  # the sample did reach facets
 
 

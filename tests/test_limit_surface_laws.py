@@ -121,9 +121,9 @@ def test_maximum_force_is_mu_times_the_normal_force():
 @LAW_SETTINGS
 @given(cor=st.tuples(st.floats(-3, 3), st.floats(-3, 3)), about=st.sampled_from(["origin", "cop"]))
 def test_moment_about_a_point_is_largest_when_rotating_about_that_point(surface, cor, about):
-    """m_o(c) = M(o) - (o - c)... : with M(c) = ∫ mu p |x - c| dA convex, the moment about ``o`` of
-    any load is at most M(o), reached for rotation about ``o`` (paper §2.3: with the origin at
-    the centre of pressure the maximum moment occurs for the COR at the origin)."""
+    """Rotating about ``c``, the moment about ``o`` is ``M(c) + (o - c)·∇M(c) <= M(o)`` because
+    ``M(c) = ∫ mu p |x - c| dA`` is convex; equality for ``c = o`` (paper §2.3: with the origin at
+    the centre of pressure, the maximum moment occurs for the COR at the origin)."""
     size = surface.characteristic_length
     if about == "cop" and surface.field is not None:
         o = surface.field.center_of_pressure(mu=surface.mu)
