@@ -109,9 +109,6 @@ def simple_polygon(name: str, vertices: np.ndarray) -> np.ndarray:
     edges = np.roll(vertices, -1, axis=0) - vertices
     if scale == 0.0 or np.any(np.hypot(edges[:, 0], edges[:, 1]) <= 1e-12 * scale):
         raise GeometryError(f"{name} has repeated consecutive vertices (a zero-length edge)")
-    area = signed_area(vertices)
-    if abs(area) <= 1e-12 * scale * scale:
-        raise GeometryError(f"{name} is degenerate: its area is zero")
     for i in range(n):
         for j in range(i + 2, n):
             if i == 0 and j == n - 1:
@@ -123,6 +120,9 @@ def simple_polygon(name: str, vertices: np.ndarray) -> np.ndarray:
                     f"{name} is self-intersecting: edge {i} crosses edge {j}; "
                     "give the vertices of a simple polygon in order around its boundary"
                 )
+    area = signed_area(vertices)
+    if abs(area) <= 1e-12 * scale * scale:
+        raise GeometryError(f"{name} is degenerate: its area is zero")
     return vertices if area > 0 else vertices[::-1].copy()
 
 

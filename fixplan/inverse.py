@@ -30,14 +30,15 @@ _FACETS_TESTED = 3
 #: there the iteration is quadratic and rounding would defeat the sufficient-decrease test.
 QUADRATIC_REGION = 1e-12
 
-#: Rounds of "push off the kink and run Newton again" for point supports.
-_FACET_RESTARTS = 4
-
 #: A support point whose weighted speed is below this fraction of h sits on a possible kink.
 _NEAR_KINK = 1e-6
 
-#: Size of that push, relative to the twist.
-_PUSH = 1e-3
+#: Smoothing speeds (relative to the translation speed of the twist) of the continuation that
+#: takes over where Newton stalls at a kink.
+_SMOOTHING_STAGES = (1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
+
+#: A Newton step damped below this fraction signals a kink: Newton stops there.
+_CRAWL = 1e-3
 
 #: Most step halvings of the backtracking line search.
 _MAX_HALVINGS = 60
@@ -96,6 +97,7 @@ def _newton(z, e1, e2, active, terms, values) -> np.ndarray:
         h, g, hess = terms(za)
         step, decrement = _newton_step(g, hess, b1, b2)
         done = decrement <= INVERSE_RTOL**2 * h
+        # Near the minimum the sufficient decrease is below rounding: full steps are taken.
         accepted = done | (decrement <= QUADRATIC_REGION * h)
         t = np.ones(len(active))
         for _ in range(_MAX_HALVINGS):
@@ -108,8 +110,11 @@ def _newton(z, e1, e2, active, terms, values) -> np.ndarray:
             t[idx[~ok]] *= 0.5
         moved = accepted & ~done
         z[active[moved]] = za[moved] + t[moved, None] * step[moved]
-        stalled[active[~accepted]] = True
-        active = active[moved]
+        # Tiny accepted steps mean Newton is crawling into a kink: stop and let the facet test
+        # and the smoothing continuation take over.
+        crawling = moved & (t < _CRAWL)
+        stalled[active[~accepted | crawling]] = True
+        active = active[moved & ~crawling]
     stalled[active] = True
     return stalled
 
@@ -130,52 +135,34 @@ def solve(
     # Normalised twist Z has L̃·Z = 1; the SI twist is Z / units.
     z = direction / length[:, None]
 
-    def terms(zs):
-        h, g, hess = kernel.newton_terms(zs / units)
-        g = g / units
-        hess = hess / units[:, None] / units[None, :]
-        return scale * h, scale * g, scale * hess
-
-    def values(zs):
-        return scale * kernel.support(zs / units)
-
+    terms, values = _objective(kernel, scale, units)
     stalled = _newton(z, e1, e2, np.arange(count), terms, values)
     safety = values(z)
     on_facet = np.zeros(count, dtype=bool)
     points, friction = kernel.facets
     if len(points):
-        for _ in range(_FACET_RESTARTS):
-            # Newton only stops short, or lands on a kink, next to a support point.
-            _, slowest = slowest_points(points, friction, z / units, 1)
-            near_kink = slowest[:, 0] <= _NEAR_KINK * safety
-            rows = np.flatnonzero((stalled | near_kink) & ~on_facet)
-            safety, found, push = _facets(
-                kernel, scale, loads, units, z, safety, points, friction, rows
-            )
-            on_facet |= found
-            # Newton stops at a kink that is not the minimum: push the stuck support point off
-            # its centre, in the direction it must slide, and start again from there.
-            retry = np.flatnonzero(stalled & ~on_facet & np.any(push != 0.0, axis=1))
-            if retry.size == 0:
-                break
-            z[retry] += push[retry]
-            z[retry] /= np.einsum("ij,ij->i", norm_loads[retry], z[retry])[:, None]
-            stalled[retry] = _newton(z, e1, e2, retry, terms, values)[retry]
-            safety[retry] = values(z[retry])
+        # Newton only stops short, or lands on a kink, next to a support point.
+        _, slowest = slowest_points(points, friction, z / units, 1)
+        near_kink = slowest[:, 0] <= _NEAR_KINK * safety
+        rows = np.flatnonzero(stalled | near_kink)
+        on_facet = _facets(kernel, scale, loads, units, z, safety, points, friction, rows)
+        retry = np.flatnonzero(stalled & ~on_facet)
+        if retry.size:
+            _continuation(kernel, scale, units, z, safety, e1, e2, retry)
+            on_facet |= _facets(kernel, scale, loads, units, z, safety, points, friction, retry)
     twist = z / units
     return InverseResult(safety_factor=safety, twist=twist, on_facet=on_facet)
 
 
-def _facets(kernel, scale, loads, units, z, safety, points, friction, rows):
-    """Replace Newton's answer by an exact facet where the load lies on one (``z`` in place).
+def _facets(kernel, scale, loads, units, z, safety, points, friction, rows) -> np.ndarray:
+    """Where the load lies on the facet of a support point, take it (``z``, ``safety`` in place).
 
-    Only ``rows`` are tested. Also returns, per query, a push of ``z`` that makes the nearest
-    support point slide (for restarting Newton off a kink that is not the minimum).
+    Only ``rows`` are tested, against the facets of the support points slowest under their
+    twists. Returns which rows were found on a facet.
     """
     on_facet = np.zeros(len(loads), dtype=bool)
-    push = np.zeros_like(z)
     if rows.size == 0:
-        return safety, on_facet, push
+        return on_facet
     nearest, _ = slowest_points(points, friction, z[rows] / units, _FACETS_TESTED)
     for column in range(nearest.shape[1]):
         k = nearest[:, column]
@@ -198,9 +185,40 @@ def _facets(kernel, scale, loads, units, z, safety, points, friction, rows):
         safety[hit_rows] = s_k[hit]
         z[hit_rows] = facet_twist[hit] * units / power[hit, None]
         on_facet[hit_rows] = True
-        if column == 0:
-            # Slide the nearest point along the force it would have to carry.
-            first = usable & ~hit & (carried > 0.0)
-            along = residual[first] / carried[first, None]
-            push[rows[first], :2] = _PUSH * along * units[:2] / power[first, None]
-    return safety, on_facet, push
+    return on_facet
+
+
+def _objective(kernel, scale, units):
+    """``h`` with gradient and Hessian, and ``h`` alone, in normalised coordinates."""
+
+    def terms(zs):
+        h, g, hess = kernel.newton_terms(zs / units)
+        g = g / units
+        hess = hess / units[:, None] / units[None, :]
+        return scale * h, scale * g, scale * hess
+
+    def values(zs):
+        return scale * kernel.support(zs / units)
+
+    return terms, values
+
+
+def _continuation(kernel, scale, units, z, safety, e1, e2, rows) -> None:
+    """Minimise ``h`` on rows where Newton stalled at a kink that is not the minimum.
+
+    Newton is drawn into the kinks of point supports. Rounding each speed off as
+    ``sqrt(|u|² + eps²)`` makes ``h`` smooth; Newton then converges, and ``eps`` is reduced
+    stage by stage down to zero, each stage starting where the last one ended. The result
+    replaces the row's twist only where it lowers ``h`` (every iterate lies on the plane, so
+    the lower ``h`` is the better answer). ``z`` and ``safety`` are updated in place.
+    """
+    start = z[rows].copy()
+    for eta in _SMOOTHING_STAGES:
+        terms, values = _objective(kernel.smoothed(eta / units[0]), scale, units)
+        _newton(z, e1, e2, rows, terms, values)
+    terms, values = _objective(kernel, scale, units)
+    _newton(z, e1, e2, rows, terms, values)
+    found = values(z[rows])
+    better = found < safety[rows]
+    z[rows[~better]] = start[~better]
+    safety[rows[better]] = found[better]

@@ -58,6 +58,11 @@ class SupportKernel(ABC):
         h, g = self.evaluate(twists)
         return h, g, self.hessian(twists)
 
+    def smoothed(self, smoothing: float) -> SupportKernel:
+        """This kernel with the kinks of its point supports rounded off over speeds below
+        ``smoothing`` (continuous fields have no kinks and return themselves)."""
+        return self
+
 
 def twist_to_local(pose: Pose) -> np.ndarray:
     """Matrix ``T`` (3x3) with ``V_local = T @ V`` for a patch placed by ``pose``.
@@ -107,6 +112,9 @@ class PosedKernel(SupportKernel):
         h, g, hess = self.local.newton_terms(twists @ transform.T)
         return h, g @ transform, transform.T @ hess @ transform
 
+    def smoothed(self, smoothing):
+        return PosedKernel(self.local.smoothed(smoothing), self.pose)
+
 
 @dataclass(frozen=True, slots=True)
 class SumKernel(SupportKernel):
@@ -150,3 +158,6 @@ class SumKernel(SupportKernel):
             g += scale * gp
             hess += scale * hessp
         return h, g, hess
+
+    def smoothed(self, smoothing):
+        return SumKernel(tuple(p.smoothed(smoothing) for p in self.parts), self.scales)

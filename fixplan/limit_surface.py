@@ -304,8 +304,8 @@ def _field_kernel(field: PressureField) -> SupportKernel:
         )
     elif isinstance(field, GridField):
         local = _grid_kernel(field)
-    elif isinstance(field, PointsField):
-        local = PointSetKernel(field.xy, field.weights, discrete=True)
+    elif isinstance(field, PointsField):  # placed directly: no rounding from a twist transform
+        return PointSetKernel(field.pose.apply(field.xy), field.weights, discrete=True)
     elif isinstance(field, FunctionField):
         from fixplan.function_kernel import FunctionKernel
 
@@ -354,7 +354,7 @@ def _varying_friction_kernel(field: PressureField, mu: Callable) -> SupportKerne
 
     if isinstance(field, PointsField):
         friction = local_mu(field.xy[:, 0], field.xy[:, 1])
-        return _posed(PointSetKernel(field.xy, field.weights * friction, discrete=True), pose)
+        return PointSetKernel(pose.apply(field.xy), field.weights * friction, discrete=True)
     from fixplan.function_kernel import FunctionKernel
 
     pressure = None

@@ -14,10 +14,15 @@ import numpy as np
 
 from fixplan.kernels import SupportKernel
 
+#: A point whose speed is below this fraction of the twist's scale at that point is stationary
+#: (the centre of rotation sits on it up to rounding): it carries no force in :func:`_evaluate`
+#: (one point of the facet) instead of a unit force in the direction of rounding noise.
+STATIONARY_RTOL = 1e-12
+
 _JIT = {"cache": True, "fastmath": {"reassoc", "contract"}, "nogil": True}
 
 
-def _evaluate(px, py, pw, twists, out_h, out_loads):  # pragma: no cover - compiled
+def _evaluate(px, py, pw, eps2, twists, out_h, out_loads):  # pragma: no cover - compiled
     for k in numba.prange(twists.shape[0]):
         vx, vy, w = twists[k, 0], twists[k, 1], twists[k, 2]
         h = 0.0
@@ -27,8 +32,8 @@ def _evaluate(px, py, pw, twists, out_h, out_loads):  # pragma: no cover - compi
         for i in range(px.shape[0]):
             ux = vx - w * py[i]
             uy = vy + w * px[i]
-            speed = math.sqrt(ux * ux + uy * uy)
-            if speed > 0.0:
+            speed = math.sqrt(ux * ux + uy * uy + eps2)
+            if speed > STATIONARY_RTOL * (abs(vx) + abs(vy) + abs(w) * (abs(px[i]) + abs(py[i]))):
                 s = pw[i] / speed
                 h += pw[i] * speed
                 gx = s * ux
@@ -42,7 +47,7 @@ def _evaluate(px, py, pw, twists, out_h, out_loads):  # pragma: no cover - compi
         out_loads[k, 2] = m
 
 
-def _newton_terms(px, py, pw, twists, out_h, out_g, out_hess):  # pragma: no cover - compiled
+def _newton_terms(px, py, pw, eps2, twists, out_h, out_g, out_hess):  # pragma: no cover
     for k in numba.prange(twists.shape[0]):
         vx, vy, w = twists[k, 0], twists[k, 1], twists[k, 2]
         h = 0.0
@@ -60,26 +65,26 @@ def _newton_terms(px, py, pw, twists, out_h, out_g, out_hess):  # pragma: no cov
             y = py[i]
             ux = vx - w * y
             uy = vy + w * x
-            speed = math.sqrt(ux * ux + uy * uy)
-            if speed > 0.0:
-                # d|u|/dV = A^T u/|u|, d²|u|/dV² = A^T (I - û û^T) A / |u|, A = [[1,0,-y],[0,1,x]].
+            speed = math.sqrt(ux * ux + uy * uy + eps2)
+            if speed > STATIONARY_RTOL * (abs(vx) + abs(vy) + abs(w) * (abs(x) + abs(y))):
+                # With s = sqrt(|u|² + eps²), A = [[1, 0, -y], [0, 1, x]] and e = u / s:
+                # ds/dV = A^T e, d²s/dV² = A^T (I - e e^T) A / s.
                 c = pw[i] / speed
                 ex = ux / speed
                 ey = uy / speed
                 h += pw[i] * speed
-                g0 += c * ux
-                g1 += c * uy
-                g2 += c * (x * uy - y * ux)
-                # (I - û û^T) = t t^T with t = (-ey, ex): rank one.
-                t0 = -ey
-                t1 = ex
-                t2 = -y * t0 + x * t1
-                h00 += c * t0 * t0
-                h01 += c * t0 * t1
-                h02 += c * t0 * t2
-                h11 += c * t1 * t1
-                h12 += c * t1 * t2
-                h22 += c * t2 * t2
+                g0 += pw[i] * ex
+                g1 += pw[i] * ey
+                g2 += pw[i] * (x * ey - y * ex)
+                m00 = c * (1.0 - ex * ex)
+                m01 = -c * ex * ey
+                m11 = c * (1.0 - ey * ey)
+                h00 += m00
+                h01 += m01
+                h11 += m11
+                h02 += -y * m00 + x * m01
+                h12 += -y * m01 + x * m11
+                h22 += y * y * m00 - 2.0 * x * y * m01 + x * x * m11
         out_h[k] = h
         out_g[k, 0] = g0
         out_g[k, 1] = g1
@@ -118,11 +123,14 @@ class PointSetKernel(SupportKernel):
     """Points ``(n, 2)`` [m] with friction weights ``(n,)`` (summing to the total friction).
 
     ``discrete`` marks true point supports, whose stationary points give the surface facets.
+    ``smoothing`` [m/s per unit twist] replaces each speed ``|u|`` by ``sqrt(|u|² + smoothing²)``
+    (a smooth, slightly larger support function, for the inverse map's continuation).
     """
 
     points: np.ndarray
     weights: np.ndarray
     discrete: bool = False
+    smoothing: float = 0.0
     _x: np.ndarray = field(init=False, repr=False)
     _y: np.ndarray = field(init=False, repr=False)
 
@@ -147,7 +155,7 @@ class PointSetKernel(SupportKernel):
         h = np.empty(len(twists))
         loads = np.empty((len(twists), 3))
         _pick(_EVALUATE, len(twists), len(self._x))(
-            self._x, self._y, self.weights, twists, h, loads
+            self._x, self._y, self.weights, self.smoothing**2, twists, h, loads
         )
         return h, loads
 
@@ -157,12 +165,15 @@ class PointSetKernel(SupportKernel):
         g = np.empty((len(twists), 3))
         hess = np.empty((len(twists), 3, 3))
         _pick(_NEWTON_TERMS, len(twists), len(self._x))(
-            self._x, self._y, self.weights, twists, h, g, hess
+            self._x, self._y, self.weights, self.smoothing**2, twists, h, g, hess
         )
         return h, g, hess
 
     def hessian(self, twists):
         return self.newton_terms(twists)[2]
+
+    def smoothed(self, smoothing: float) -> PointSetKernel:
+        return PointSetKernel(self.points, self.weights, self.discrete, smoothing)
 
 
 def _slowest(px, py, pw, twists, out_index, out_speed):  # pragma: no cover - compiled

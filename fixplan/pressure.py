@@ -315,7 +315,9 @@ def points(xy, weights=None, *, centered: bool = True) -> PointsField:
     """
     xy_array = validation.finite_array("xy", xy, shape=(None, 2))
     if len(xy_array) == 0:
-        raise InvalidArgumentError("xy must hold at least one point, got an empty set")
+        raise InvalidArgumentError(
+            "xy must hold at least two distinct loaded points (n >= 2), got an empty set"
+        )
     if weights is None:
         w = np.ones(len(xy_array))
     else:

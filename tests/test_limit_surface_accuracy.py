@@ -115,11 +115,19 @@ def _assert_matches(surface, twist, h_ref, load_ref, size, rtol):
 # -- the references themselves ----------------------------------------------------------------
 
 
-@pytest.mark.parametrize("u", [0.0, 1e-6, 0.3, 0.999999, 1.0, 1.000001, 2.0, 40.0, 1e3])
-@pytest.mark.parametrize("shape", ["uniform", "hertz", "ring", "annulus"])
+_REFERENCE_US = [0.0, 1e-6, 0.3, 0.999999, 1.0, 1.000001, 2.0, 40.0, 1e3]
+
+
+@pytest.mark.parametrize(
+    ("shape", "u"),
+    [
+        (shape, u)
+        for shape in ("uniform", "hertz", "ring", "annulus")
+        for u in _REFERENCE_US
+        if shape != "hertz" or u <= 1.0  # DESIGN.md §4 has no Hertz form outside the disk
+    ],
+)
 def test_reference_quadrature_matches_the_closed_forms_of_disks(shape, u):
-    if shape == "hertz" and u > 1.0:
-        pytest.xfail("DESIGN.md §4 gives no Hertz closed form outside the disk")
     region = {
         "uniform": ref.Disk(1.0),
         "hertz": ref.Disk(1.0),

@@ -235,6 +235,35 @@ def test_surface_scales_linearly_with_mu_and_normal_force(surface, rng, mu_facto
     )
 
 
+#: Cheap fields (closed forms and point sets) for property tests that rebuild surfaces.
+SCALING_FIELDS = {
+    "hertz disk": pressure.disk(0.004, "hertz"),
+    "annulus": pressure.disk(0.02, "annulus", inner_radius=0.01),
+    "rectangle": pressure.rectangle(0.08, 0.02).rotated(0.3),
+    "grid": pressure.grid([0.0, 0.01], [0.0, 0.01, 0.02], [[1.0, 2.0], [0.0, 1.0], [3.0, 1.0]]),
+    "points": pressure.points([[0.0, 0.0], [0.03, 0.0], [0.0, 0.02]], [1.0, 2.0, 3.0]),
+}
+
+
+@LAW_SETTINGS
+@given(
+    name=st.sampled_from(sorted(SCALING_FIELDS)),
+    mu=st.floats(1e-3, 10.0),
+    normal_force=st.floats(1e-3, 1e4),
+    a=directions,
+)
+def test_loads_scale_linearly_with_any_mu_and_normal_force(name, mu, normal_force, a):
+    field = SCALING_FIELDS[name]
+    unit = LimitSurface(field, mu=1.0, normal_force=1.0)
+    surface = LimitSurface(field, mu=mu, normal_force=normal_force)
+    twist = _twist(unit, a)
+    k = mu * normal_force
+    assert np.allclose(surface.load(twist), k * unit.load(twist), rtol=1e-13, atol=0)
+    assert surface.support(twist) == pytest.approx(k * unit.support(twist), rel=1e-13)
+    load = unit.load(twist)
+    assert surface.safety_factor(load) == pytest.approx(k, rel=1e-9)
+
+
 def test_midpoints_of_surface_points_are_held(surface):
     """Convexity of the held set: the midpoint of two loads on the surface is held."""
     sample = surface.sample(12)
