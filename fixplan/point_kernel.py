@@ -7,6 +7,7 @@ quadrature rules of continuous fields, and for the far field of polygons.
 from __future__ import annotations
 
 import math
+import types
 from dataclasses import dataclass, field
 
 import numba
@@ -106,8 +107,16 @@ PARALLEL_MIN_WORK = 200_000
 
 
 def _compiled(function):
-    """A function compiled twice: (serial, parallel)."""
-    return numba.njit(parallel=False, **_JIT)(function), numba.njit(parallel=True, **_JIT)(function)
+    """A function compiled twice: (serial, parallel).
+
+    The serial variant is compiled from a renamed copy: numba's on-disk cache is keyed by the
+    function's name, and two variants of one function would load each other's machine code.
+    """
+    serial = types.FunctionType(
+        function.__code__, function.__globals__, f"{function.__name__}_serial"
+    )
+    serial.__qualname__ = f"{function.__qualname__}_serial"
+    return numba.njit(parallel=False, **_JIT)(serial), numba.njit(parallel=True, **_JIT)(function)
 
 
 _EVALUATE = _compiled(_evaluate)
