@@ -25,6 +25,7 @@ OBJECTIVES = (
     "min-total-clamp-force",
     "min-max-normal-force",
     "min-total-normal-force",
+    "min-squared-normal-force",
     "max-safety-factor",
     "check",
 )

@@ -210,6 +210,18 @@ def test_osqp_solves_pyramid_problems_like_clarabel():
     assert osqp.objective_value == pytest.approx(clarabel.objective_value, rel=1e-5)
 
 
+def test_quadratic_grip_effort_with_pyramids_is_a_qp_that_osqp_and_clarabel_agree_on():
+    cases = [off_axis_load(weight=w, offset=0.0) for w in (4.0, 6.0)]
+    cases = [Load(name=f"w{k}", force=c.force, point=c.point) for k, c in enumerate(cases)]
+    problem = pinch("point-pyramid", load=cases, objective="min-squared-normal-force", facets=8)
+    clarabel, osqp = solve(problem), solve(problem, solver="OSQP")
+    assert osqp.status == clarabel.status == "optimal"
+    # Each finger carries half of each weight through an inscribed octagon: N = (W/2)/(mu cos(pi/8)).
+    expected = sum(2 * ((w / 2) / (MU * np.cos(np.pi / 8))) ** 2 for w in (4.0, 6.0))
+    assert clarabel.objective_value == pytest.approx(expected, rel=1e-6)
+    assert osqp.objective_value == pytest.approx(expected, rel=1e-5)
+
+
 def test_osqp_refuses_conic_models_with_advice():
     with pytest.raises(InvalidArgumentError, match="pyramid"):
         solve(pinch("ellipsoid", load=off_axis_load()), solver="OSQP")
