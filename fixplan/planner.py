@@ -10,7 +10,9 @@ to the body wrench about the world origin, ``F_i`` its friction model at unit no
 ``W_j`` the task wrench and ``W_g`` gravity. Force objectives fix ``s_j = 1`` and minimise
 normal forces; the fixed-force objectives maximise each ``s_j``. The cvxpy problem is built once
 per structure with Parameters for the task wrenches, gravity and the fixed forces (it is DPP), so
-new load values re-solve without rebuilding. The dual of the equilibrium constraint of a case is
+new load values re-solve without rebuilding; small problems re-solve straight through Clarabel
+(:mod:`fixplan.direct_solve`), large ones (the sum-of-disks model) skip cvxpy's DPP compilation,
+which costs more there than canonicalising afresh. The dual of the equilibrium constraint of a case is
 the twist in which the body starts to slide (maximum power); for an infeasible problem it is the
 motion that nothing resists.
 """
@@ -39,6 +41,9 @@ from fixplan.tolerances import (
 )
 
 SOLVERS = ("CLARABEL", "OSQP", "SCS")
+#: Above this many scalar variables problems are solved without DPP (see Planner._call).
+DPP_MAX_VARIABLES = 10_000
+
 #: Load cases per compiled problem of the fixed-force objectives (their cases are independent).
 CASES_PER_BLOCK = 32
 _FALLBACK = {"CLARABEL": "SCS", "SCS": "CLARABEL", "OSQP": "CLARABEL"}
@@ -363,16 +368,21 @@ class Planner:
             return
         if objective in self._direct or built.problem.status != cp.OPTIMAL:
             return
+        if built.problem.size_metrics.num_scalar_variables > DPP_MAX_VARIABLES:
+            return
         self._solves[objective] = self._solves.get(objective, 0) + 1
         if self._solves[objective] >= 2:
             self._direct[objective] = DirectSolver.create(built.problem, _DIRECT_OPTIONS)
 
     @staticmethod
     def _call(problem: cp.Problem, solver: str) -> str:
+        # cvxpy's DPP compilation grows much faster than the problem: past DPP_MAX_VARIABLES
+        # (e.g. the sum-of-disks model of many contacts) canonicalising afresh is far quicker.
+        large = problem.size_metrics.num_scalar_variables > DPP_MAX_VARIABLES
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                problem.solve(solver=solver, **_SOLVER_OPTIONS[solver])
+                problem.solve(solver=solver, ignore_dpp=large, **_SOLVER_OPTIONS[solver])
         except cp.error.SolverError as exc:
             if solver == "OSQP" and "QP" in str(exc):
                 raise InvalidArgumentError(
