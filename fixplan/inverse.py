@@ -19,9 +19,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fixplan.errors import ConvergenceError
 from fixplan.kernels import SupportKernel
 from fixplan.point_kernel import slowest_points
-from fixplan.tolerances import FACET_RTOL, INVERSE_MAX_ITERATIONS, INVERSE_RTOL
+from fixplan.tolerances import (
+    FACET_RTOL,
+    INVERSE_GRADIENT_RTOL,
+    INVERSE_MAX_ITERATIONS,
+    INVERSE_RTOL,
+)
 
 #: Number of nearest support points whose facets are tested per query.
 _FACETS_TESTED = 3
@@ -46,11 +52,10 @@ _MAX_HALVINGS = 60
 
 @dataclass(frozen=True, slots=True)
 class InverseResult:
-    """Safety factors ``(K,)`` and unit normalised twists ``(K, 3)`` of a batch of loads."""
+    """Safety factors ``(K,)`` and sliding twists ``(K, 3)`` (SI units, any scale) of loads."""
 
     safety_factor: np.ndarray
-    twist: np.ndarray  # (vx, vy, w) in SI units, scaled later by the caller
-    on_facet: np.ndarray
+    twist: np.ndarray
 
 
 def _plane_basis(direction: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -150,8 +155,23 @@ def solve(
         if retry.size:
             _continuation(kernel, scale, units, z, safety, e1, e2, retry)
             on_facet |= _facets(kernel, scale, loads, units, z, safety, points, friction, retry)
-    twist = z / units
-    return InverseResult(safety_factor=safety, twist=twist, on_facet=on_facet)
+    _check_converged(z[stalled & ~on_facet], e1[stalled & ~on_facet], e2[stalled & ~on_facet],
+                     loads[stalled & ~on_facet], terms)  # fmt: skip
+    return InverseResult(safety_factor=safety, twist=z / units)
+
+
+def _check_converged(z, e1, e2, loads, terms) -> None:
+    """Raise :class:`ConvergenceError` where Newton stopped away from a minimum."""
+    if len(z) == 0:
+        return
+    h, g, _ = terms(z)
+    projected = np.hypot(np.einsum("ij,ij->i", g, e1), np.einsum("ij,ij->i", g, e2))
+    bad = np.flatnonzero(projected > INVERSE_GRADIENT_RTOL * h)
+    if bad.size:
+        raise ConvergenceError(
+            f"the inverse map did not converge for load {loads[bad[0]].tolist()} (relative "
+            f"gradient {projected[bad[0]] / h[bad[0]]:.2g}); please report this load"
+        )
 
 
 def _facets(kernel, scale, loads, units, z, safety, points, friction, rows) -> np.ndarray:

@@ -27,9 +27,6 @@ HESSIAN_STEP = 1e-6
 #: integrand is used instead.
 FAR_FIELD_RADII = 4.0
 
-#: Points of a pressure field closer than this fraction of the field's size are one point.
-COINCIDENT_POINTS_RTOL = 1e-12
-
 #: The planner's equilibrium residual must be below this fraction of the largest wrench term.
 EQUILIBRIUM_RTOL = 1e-6
 
@@ -61,3 +58,7 @@ HELD_RTOL = 1e-6
 #: Screw-axis points closer than this fraction of the body's length scale to a coordinate
 #: plane are printed on it (solver noise).
 SCREW_PRINT_RTOL = 1e-6
+
+#: The inverse map's answer must have a projected gradient below this fraction of h (at a
+#: smooth minimum it is zero); otherwise it raises ConvergenceError instead of guessing.
+INVERSE_GRADIENT_RTOL = 1e-7
