@@ -317,12 +317,20 @@ def _field_kernel(field: PressureField) -> SupportKernel:
     return _posed(local, field.pose)
 
 
-def _grid_kernel(field: GridField) -> EdgeSumKernel:
+def _cell_squares(field: GridField) -> tuple[np.ndarray, np.ndarray]:
+    """Corners ``(n, 4, 2)`` (counter-clockwise) and force fractions of the loaded cells."""
     centers, fractions = field.cells()
     dx, dy = field.cell_size
     corners = np.array([[-dx, -dy], [dx, -dy], [dx, dy], [-dx, dy]]) / 2.0
-    starts = (centers[:, None, :] + corners[None, :, :]).reshape(-1, 2)
-    ends = (centers[:, None, :] + np.roll(corners, -1, axis=0)[None, :, :]).reshape(-1, 2)
+    return centers[:, None, :] + corners[None, :, :], fractions
+
+
+def _grid_kernel(field: GridField) -> EdgeSumKernel:
+    squares, fractions = _cell_squares(field)
+    centers = squares.mean(axis=1)
+    dx, dy = field.cell_size
+    starts = squares.reshape(-1, 2)
+    ends = np.roll(squares, -1, axis=1).reshape(-1, 2)
     weights = np.repeat(fractions / (dx * dy), 4)
     order = 8 if len(centers) <= 16 else 4 if len(centers) <= 256 else 3
     t, wt = gauss_jacobi_unit(order)
@@ -372,12 +380,8 @@ def _varying_friction_kernel(field: PressureField, mu: Callable) -> SupportKerne
     elif isinstance(field, PolygonField):
         regions = _regions(field)
     elif isinstance(field, GridField):
-        centers, fractions = field.cells()
-        dx, dy = field.cell_size
-        corners = np.array([[-dx, -dy], [dx, -dy], [dx, dy], [-dx, dy]]) / 2.0
-        regions = tuple(
-            ("polygon", c + corners, f) for c, f in zip(centers, fractions, strict=True)
-        )
+        squares, fractions = _cell_squares(field)
+        regions = tuple(("polygon", s, f) for s, f in zip(squares, fractions, strict=True))
     elif isinstance(field, FunctionField):
         regions, pressure = _regions(field.shape), field.function
     else:  # pragma: no cover
