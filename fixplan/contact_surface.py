@@ -83,6 +83,21 @@ class ContactSetSurface:
         self._support = cp.Problem(cp.Maximize(self._direction @ wrench), constraints)
         self._units = self._axis_extents()
 
+    @classmethod
+    def from_plan(
+        cls, problem, plan, load: str, subspace: Sequence[str] = ("fx", "fy", "mz")
+    ) -> ContactSetSurface:
+        """The surface of ``problem``'s contacts with the normal forces ``plan`` found for load
+        case ``load`` (at the state the plan reports for it)."""
+        if plan.normal_forces is None:
+            raise InvalidArgumentError(f"the plan has no contact forces (status {plan.status!r})")
+        if load not in plan.load_names:
+            raise InvalidArgumentError(
+                f"load must be one of the plan's load cases {list(plan.load_names)}; got {load!r}"
+            )
+        forces = np.clip(plan.normal_forces[:, plan.load_names.index(load)], 0.0, None)
+        return cls(problem.contacts, forces, subspace)
+
     def _solve(self, problem: cp.Problem) -> None:
         problem.solve(solver=cp.CLARABEL, **_OPTIONS)
         if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):

@@ -295,3 +295,21 @@ def test_solutions_are_verified_without_warnings():
         plan = solve(pinch("exact", load=off_axis_load()))
     assert plan.status == "optimal"
     assert plan.residual < 1e-7
+
+
+def test_contact_set_surface_of_a_plan_holds_what_the_plan_says_is_at_the_limit():
+    xy = np.array([[0.03, 0.0], [-0.02, 0.025], [-0.02, -0.03]])
+    contacts = [
+        Contact(name=f"p{k}", role="support", position=[x, y, 0], normal=[0, 0, 1], mu=MU,
+                model="point-cone")
+        for k, (x, y) in enumerate(xy)
+    ]  # fmt: skip
+    problem = Problem(
+        body=Body(mass=2.0, center_of_mass=[0.0, 0.0, 0.05]), contacts=contacts, loads=[PUSH],
+        objective="max-safety-factor",
+    )  # fmt: skip
+    plan = solve(problem)
+    surface = ContactSetSurface.from_plan(problem, plan, "push")
+    # At the state of impending slip the push, scaled by its safety factor, is on the surface.
+    scaled = plan.safety_factors["push"] * planar_load(PUSH)
+    assert surface.safety_factor(scaled) == pytest.approx(1.0, rel=1e-6)
