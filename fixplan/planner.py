@@ -480,7 +480,7 @@ class Planner:
         motions = {}
         for j, name in enumerate(names):
             twist = None if dual is None or not np.isfinite(safety[j]) else dual[:, j]
-            if twist is not None:
+            if twist is not None and np.any(twist):
                 twist = self._keep_contact(twist, normal[:, j])
             if twist is None or not np.any(twist):
                 motions[name] = None
@@ -512,13 +512,15 @@ class Planner:
             ].name,
         }
 
-    def _keep_contact(self, twist: np.ndarray, normal_forces: np.ndarray) -> np.ndarray | None:
+    def _keep_contact(self, twist: np.ndarray, normal_forces: np.ndarray) -> np.ndarray:
         """The twist nearest ``twist`` in which every pressed contact stays in contact.
 
         The dual of the equilibrium is the associated flow of the Coulomb cones, which lifts a
         sliding contact off by ``mu`` times its sliding speed (dilatancy). Real contacts that
         press keep touching, so the normal velocity of the body at each pressed contact is
-        projected out. ``None`` when nothing is left (the contacts allow no sliding).
+        projected out — unless that removes most of the motion (when the pressed contacts
+        leave no sliding motion at all, one of them must lift off as it starts to slide); then
+        the dual twist itself, which lifts no contact into the body, is the answer.
         """
         size = max(float(np.abs(normal_forces).max()), 1e-300)
         pressed = np.flatnonzero(normal_forces > FRICTION_SET_RTOL * size)
@@ -526,12 +528,12 @@ class Planner:
             return twist
         # Normal velocity of the body at contact i: n·(v + ω × p) = G_n[:, i] · (v, ω).
         rows = self._normal_map[:, pressed].T
-        basis = np.linalg.svd(rows)[2]
-        rank = int(np.sum(np.linalg.svd(rows, compute_uv=False) > 1e-9 * self.length_scale))
+        _, singular, basis = np.linalg.svd(rows)
+        rank = int(np.sum(singular > 1e-9 * self.length_scale))
         free = basis[rank:]
         projected = free.T @ (free @ twist)
-        scale = np.linalg.norm(twist)
-        return projected if np.linalg.norm(projected) > 1e-9 * scale else None
+        kept = np.linalg.norm(projected) >= 0.5 * np.linalg.norm(twist)
+        return projected if kept else twist
 
     def _certificate(self, result, wrenches, names) -> tuple[dict, str]:
         """The unresisted motions of an infeasible problem, in words."""
