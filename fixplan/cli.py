@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from fixplan import __version__, pressure
-from fixplan.errors import FixplanError, InvalidArgumentError
+from fixplan.errors import ConvergenceError, FixplanError, InvalidArgumentError
 from fixplan.problem import MODEL_NAMES
 
 EXIT_OK = 0
@@ -399,9 +399,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             warnings.simplefilter("ignore" if args.quiet else "default")
             with np.errstate(all="ignore"):
                 return args.run(args)
+    except ConvergenceError as exc:
+        print(f"fixplan: numerical failure: {exc}", file=sys.stderr)
+        return EXIT_SOLVER
     except FixplanError as exc:
         print(f"fixplan: error: {exc}", file=sys.stderr)
-        return EXIT_INVALID_INPUT
+        # Errors about the input derive from ValueError; any other is fixplan's own failure.
+        return EXIT_INVALID_INPUT if isinstance(exc, ValueError) else EXIT_UNEXPECTED
     except KeyboardInterrupt:  # pragma: no cover
         return EXIT_UNEXPECTED
     except Exception as exc:

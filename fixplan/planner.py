@@ -41,6 +41,9 @@ from fixplan.tolerances import (
 )
 
 SOLVERS = ("CLARABEL", "OSQP", "SCS")
+#: Suffix of the second stage of a force objective (clamps given, fingers minimised per case).
+REFINE = "|refine"
+
 #: Above this many scalar variables problems are solved without DPP (see Planner._call).
 DPP_MAX_VARIABLES = 10_000
 
@@ -126,21 +129,24 @@ class Planner:
         return min(cases, CASES_PER_BLOCK) if objective in FIXED_FORCE_OBJECTIVES else cases
 
     def _build(self, objective: str) -> _Built:
+        """The compiled problem of ``objective``; ``objective + REFINE`` is its second stage,
+        with the clamp forces given (see :meth:`_refine`)."""
         if objective in self._built:
             return self._built[objective]
         contacts = self.problem.contacts
         cases = self._block_size(objective)
         scaling = objective in FIXED_FORCE_OBJECTIVES
+        refine = objective.endswith(REFINE)
         task = cp.Parameter((6, cases), name="task_wrenches")
         gravity = cp.Parameter(6, name="gravity_wrench")
         friction = cp.Variable((self._friction_map.shape[1], cases), name="friction")
         rows, fixed, constraints = [], {}, []
-        free_clamps, free_fingers = [], []
+        free_clamps, free_fingers, free = [], [], []
         ones = np.ones(cases)
         for i, contact in enumerate(contacts):
             if contact.role in PASSIVE_ROLES:
                 row = cp.Variable(cases, nonneg=True, name=f"fn_{i}")
-            elif scaling or contact.force is not None:
+            elif scaling or contact.force is not None or (refine and contact.role == "clamp"):
                 shape = () if contact.role == "clamp" else (cases,)
                 fixed[i] = cp.Parameter(shape, nonneg=True, name=f"force_{i}")
                 row = fixed[i] * ones if contact.role == "clamp" else fixed[i]
@@ -153,6 +159,7 @@ class Planner:
                     variable = cp.Variable(cases, nonneg=True, name=f"finger_{i}")
                     free_fingers.append(variable)
                     row = variable
+                free.append(i)
                 if contact.max_force is not None:
                     constraints.append(variable <= contact.max_force)
             rows.append(cp.reshape(row, (1, cases), order="C"))
@@ -173,29 +180,33 @@ class Planner:
         for i, model in enumerate(self.models):
             for j in range(cases):
                 constraints += model.constraints(friction[self._slices[i], j], normal[i, j])
-        problem = cp.Problem(
-            self._objective(objective, scale, normal, free_clamps, free_fingers), constraints
+        goal = self._objective(
+            objective.removesuffix(REFINE), scale, normal[free, :], free_clamps, free_fingers
         )
+        problem = cp.Problem(goal, constraints)
         if not problem.is_dcp(dpp=True):  # pragma: no cover - a model broke its contract
             raise FixplanError("internal error: the planning problem is not DPP")
         built = _Built(problem, task, gravity, fixed, normal, friction, scale, balance_constraint)
         self._built[objective] = built
         return built
 
-    def _objective(self, objective, scale, normal, free_clamps, free_fingers):
-        active = [i for i, c in enumerate(self.problem.contacts) if c.is_active]
+    def _objective(self, objective, scale, free_forces, free_clamps, free_fingers):
+        """The objective over the free active forces ``free_forces`` (rows: contacts).
+
+        Given forces are constants and stay out of it, so that it does not go flat.
+        """
         if objective in FIXED_FORCE_OBJECTIVES:
             return cp.Maximize(cp.sum(scale))
-        if objective == "min-total-clamp-force":
-            total = cp.sum(cp.hstack(free_clamps)) if free_clamps else 0.0
-            if free_fingers:
-                total = total + cp.max(cp.sum(cp.vstack(free_fingers), axis=0))
-            return cp.Minimize(total)
-        active_forces = normal[active, :]
         # Without a free clamp the load cases are independent: minimising the sum of the per-case
         # worst values gives every case its own least forces, and the largest of them is the
         # min-max. A free clamp couples the cases, and then the max is minimised directly.
         worst = cp.max if free_clamps else cp.sum
+        if objective == "min-total-clamp-force":
+            total = cp.sum(cp.hstack(free_clamps)) if free_clamps else 0.0
+            if free_fingers:
+                total = total + worst(cp.sum(cp.vstack(free_fingers), axis=0))
+            return cp.Minimize(total)
+        active_forces = free_forces
         if objective == "min-max-normal-force":
             return cp.Minimize(worst(cp.max(active_forces, axis=0)))
         if objective == "min-total-normal-force":
@@ -230,6 +241,8 @@ class Planner:
             i: c.force for i, c in enumerate(self.problem.contacts) if c.force is not None
         }
         result = self._run(objective, wrenches, fixed_values, progress)
+        if result["status"] == "optimal":
+            result = self._refine(objective, result, wrenches, fixed_values)
         plan_kwargs = {"load_names": tuple(x.name for x in loads)}
         status, solver = result["status"], result["solver"]
         notes = list(result["warnings"])
@@ -265,6 +278,23 @@ class Planner:
             normal_forces=normal, contact_wrenches=self._wrenches(normal, friction),
             forces=forces, residual=residual, **extra,
         )  # fmt: skip
+
+    def _refine(self, objective: str, result: dict, wrenches, fixed_values: dict) -> dict:
+        """Second stage of a force objective whose free clamps couple the load cases.
+
+        The first stage leaves the fingers of the non-critical cases anywhere below the
+        critical value (the objective is flat there). With the clamp forces it found given,
+        the cases are independent and each case's finger forces are minimised on their own.
+        """
+        contacts = self.problem.contacts
+        free_clamps = [i for i, c in enumerate(contacts) if c.role == "clamp" and c.force is None]
+        free_fingers = [i for i, c in enumerate(contacts) if c.role == "finger" and c.force is None]
+        if objective in FIXED_FORCE_OBJECTIVES or not free_clamps or not free_fingers:
+            return result
+        given = dict(fixed_values)
+        given.update({i: float(result["normal"][i, 0]) for i in free_clamps})
+        refined = self._run(objective + REFINE, wrenches, given)
+        return refined if refined["status"] == "optimal" else result
 
     def _indexed(self, forces):
         names = {c.name: i for i, c in enumerate(self.problem.contacts)}
@@ -473,7 +503,7 @@ class Planner:
 
     def _analysis(self, result, wrenches, names) -> dict:
         """Safety factors, motions and utilisation from a fixed-force (scaling) solve."""
-        scale = result["scale"]
+        scale = np.maximum(result["scale"], 0.0)  # the solver may return -1e-19 for 0
         safety = np.where(scale >= MAX_SAFETY_FACTOR * (1 - 1e-6), np.inf, scale)
         dual = result.get("dual")
         normal, friction = result["normal"], result["friction"]

@@ -258,12 +258,26 @@ class Contact:
             return self.model in AREA_MODEL_NAMES
         return getattr(self.model, "torsion", True)
 
+    @property
+    def center_of_pressure(self) -> np.ndarray:
+        """World point [m] where the normal force acts: the patch's centre of pressure (the
+        contact position for point models and centred patches)."""
+        if self.patch is None:
+            return self.position
+        t1, t2, _ = self.frame
+        x, y = self.patch.center_of_pressure()
+        return self.position + x * t1 + y * t2
+
     def wrench_basis(self) -> np.ndarray:
-        """Map ``(6, 4)`` from ``(fn, ft1, ft2, mn)`` to the body wrench about the world origin."""
+        """Map ``(6, 4)`` from ``(fn, ft1, ft2, mn)`` to the body wrench about the world origin.
+
+        The normal force acts at the patch's centre of pressure; the friction load (about the
+        contact position, like the patch's limit surface) at the contact position.
+        """
         t1, t2, n = self.frame
         p = self.position
         columns = [
-            np.concatenate([n, np.cross(p, n)]),
+            np.concatenate([n, np.cross(self.center_of_pressure, n)]),
             np.concatenate([t1, np.cross(p, t1)]),
             np.concatenate([t2, np.cross(p, t2)]),
             np.concatenate([np.zeros(3), n]),

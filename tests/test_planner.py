@@ -1,5 +1,6 @@
 """The convex planner against analytic cases, ordering laws and its own contracts."""
 
+import dataclasses
 import warnings
 
 import numpy as np
@@ -313,3 +314,63 @@ def test_contact_set_surface_of_a_plan_holds_what_the_plan_says_is_at_the_limit(
     # At the state of impending slip the push, scaled by its safety factor, is on the surface.
     scaled = plan.safety_factors["push"] * planar_load(PUSH)
     assert surface.safety_factor(scaled) == pytest.approx(1.0, rel=1e-6)
+
+
+def test_a_load_that_nothing_can_balance_has_safety_factor_zero():
+    # Fixed fingers push along y; a load along the grasp axis cannot be balanced at any scale
+    # above zero (only the fixed squeeze acts along it).
+    problem = pinch("ellipsoid", load=Load(name="push", force=[0.5, -2.0, 0.3], point=[0.01, 0, 0]),
+                    objective="check", force=12.0)  # fmt: skip
+    plan = solve(problem)
+    assert plan.status == "optimal"
+    assert plan.safety_factors["push"] == pytest.approx(0.0, abs=1e-9)
+    assert plan.held == {"push": False}
+    assert plan.critical_load == "push"
+
+
+def test_a_shifted_patch_is_the_same_contact_as_a_moved_centred_one():
+    load = off_axis_load(offset=0.02)
+    shifted = pinch("ellipsoid", load=load, patch=pressure.disk(RADIUS).shifted(0.01, 0.0))
+    moved = Problem(
+        body=WEIGHTLESS,
+        contacts=[
+            Contact(name=c.name, role=c.role, position=c.position + 0.01 * c.frame[0],
+                    normal=c.normal, mu=MU, model="ellipsoid", patch=pressure.disk(RADIUS))
+            for c in shifted.contacts
+        ],
+        loads=[load],
+        objective="min-max-normal-force",
+    )  # fmt: skip
+    assert solve(shifted).objective_value == pytest.approx(solve(moved).objective_value, rel=1e-7)
+
+
+def test_fingers_get_their_least_force_per_case_even_beside_a_free_clamp():
+    top = Contact(name="top", role="clamp", position=[0, 0, 0.01], normal=[0, 0, -1], mu=MU,
+                  model="point-cone")  # fmt: skip
+    base = pinch("point-cone", load=off_axis_load(offset=0.0))
+    cases = [Load(name="big", force=[0, 0, -20.0], point=[0, 0, 0]),
+             Load(name="small", force=[0, 0, -2.0], point=[0, 0, 0])]  # fmt: skip
+    problem = Problem(body=WEIGHTLESS, contacts=[*base.contacts, top], loads=cases,
+                      objective="min-max-normal-force")  # fmt: skip
+    plan = solve(problem)
+    clamp = plan.forces["top"]
+    # With the clamp pressing down, the small case needs fingers only for what the clamp does
+    # not carry; each case's own least finger force, not the big case's.
+    small = Planner(
+        Problem(body=WEIGHTLESS, contacts=[*base.contacts, dataclasses.replace(top, force=clamp)],
+                loads=[cases[1]], objective="min-max-normal-force")
+    ).solve()  # fmt: skip
+    assert plan.forces["left"][1] == pytest.approx(small.forces["left"][0], abs=1e-6)
+
+
+def test_given_forces_stay_out_of_the_objective():
+    fixed = Contact(name="top", role="clamp", position=[0, 0, 0.01], normal=[0, 0, 1], mu=MU,
+                    model="point-cone", force=50.0)  # fmt: skip
+    base = pinch("point-cone", load=off_axis_load(offset=0.0))
+    lone = solve(base).forces["left"]
+    with_clamp = solve(Problem(body=WEIGHTLESS, contacts=[*base.contacts, fixed],
+                               loads=base.loads, objective="min-max-normal-force"))  # fmt: skip
+    # The fixed clamp pushes up with 50 N against the 10 N load: the fingers hold the 40 N
+    # left over, 20 N each, with N = 20 / mu; not anything up to the clamp's 50 N.
+    assert lone[0] == pytest.approx(10.0 / 2 / MU, rel=1e-6)
+    assert with_clamp.forces["left"][0] == pytest.approx(40.0 / 2 / MU, rel=1e-6)
