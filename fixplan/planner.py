@@ -119,6 +119,9 @@ class Planner:
         self.length_scale = float(max(spread.max(), 1e-3))
         self._built: dict[str, _Built] = {}
         self._direct: dict[str, DirectSolver | None] = {}
+        # The fixed-force objectives scale the task loads from 0: infeasible means the weight
+        # (with the given forces) cannot be held.
+        self._fixed_forces = problem.objective in FIXED_FORCE_OBJECTIVES
         self._solves: dict[str, int] = {}
 
     # -- building -----------------------------------------------------------------------------
@@ -581,9 +584,10 @@ class Planner:
             twist = twist if load @ twist >= 0.0 else -twist
             screw = Screw.from_twist(twist, self.length_scale)
             motions[name] = screw
+            cause = " even without its task load (the weight alone)" if self._fixed_forces else ""
             lines.append(
-                f"load case {name!r} cannot be held: nothing resists the motion in which the body "
-                f"{screw.describe()}"
+                f"load case {name!r} cannot be held{cause}: nothing resists the motion in which "
+                f"the body {screw.describe()}"
             )
         if not lines:
             return {}, "the problem is infeasible (the certificate is empty)"

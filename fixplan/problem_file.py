@@ -90,6 +90,13 @@ SCHEMA_VERSION = 1
 KINDS = ("fixture", "grasp")
 PATCH_SHAPES = ("disk", "rectangle", "polygon", "points", "grid")
 PYRAMID_MODEL_NAMES = ("pyramid", "point-pyramid")
+#: The point model a model override gives to contacts without a patch.
+POINT_VERSION = {
+    "exact": "point-cone",
+    "ellipsoid": "point-cone",
+    "cone": "point-cone",
+    "pyramid": "point-pyramid",
+}
 
 #: A contact normal in a file must have length 1 within this absolute tolerance (a guard against
 #: typos; the value is normalised exactly when the contact is built).
@@ -217,8 +224,9 @@ def load_problem(path: str | os.PathLike[str], *, model: str | None = None) -> P
         The problem file.
     model : str, optional
         Friction model that replaces every contact's model (one of
-        :data:`fixplan.problem.MODEL_NAMES`). An area model then needs a patch on every contact;
-        ``facets`` and ``inscribed`` are dropped from contacts when it is not a pyramid.
+        :data:`fixplan.problem.MODEL_NAMES`). With an area model, contacts without a patch get
+        its point version (:data:`POINT_VERSION`); ``facets`` and ``inscribed`` are dropped from
+        contacts when the model is not a pyramid.
 
     Returns
     -------
@@ -604,6 +612,8 @@ class _Reader:
         mu = _with_default(table, "mu", _POSITIVE, defaults, required=True)
         file_model = _with_default(table, "model", _MODEL, defaults, required=self.model is None)
         model = self.model or file_model
+        if self.model in AREA_MODEL_NAMES and "patch" not in table.data:
+            model = POINT_VERSION[self.model]  # an override keeps point contacts point contacts
         facets = self._pyramid_option(table, "facets", _FACETS, defaults, model)
         inscribed = self._pyramid_option(table, "inscribed", _BOOLEAN, defaults, model)
         patch, patch_axis = self._patch(table)

@@ -374,3 +374,13 @@ def test_given_forces_stay_out_of_the_objective():
     # left over, 20 N each, with N = 20 / mu; not anything up to the clamp's 50 N.
     assert lone[0] == pytest.approx(10.0 / 2 / MU, rel=1e-6)
     assert with_clamp.forces["left"][0] == pytest.approx(40.0 / 2 / MU, rel=1e-6)
+
+
+def test_given_forces_too_weak_for_the_weight_are_explained_as_such():
+    heavy = Body(mass=2.0, center_of_mass=[0, 0, 0])
+    base = pinch("point-cone", load=off_axis_load(offset=0.0), objective="check", force=5.0)
+    plan = solve(dataclasses.replace(base, body=heavy))
+    # Two fingers at 5 N with mu = 0.5 hold 5 N; the part weighs 19.6 N.
+    assert plan.status == "infeasible"
+    assert "even without its task load (the weight alone)" in plan.certificate
+    assert abs(plan.infeasible_motions["off-axis"].direction @ [0, 0, 1]) == pytest.approx(1.0)

@@ -184,11 +184,13 @@ def test_a_model_override_replaces_every_contact_model(tmp_path, model, facets):
     assert [c.facets for c in loaded.problem.contacts] == facets
 
 
-def test_an_area_model_override_needs_a_patch_on_every_contact(tmp_path):
-    issues = _issues(tmp_path, VALID, model="cone")
-    assert len(issues) == 1
-    _assert_issue(issues, "contacts[2].patch", "contact 'rest' needs a patch")
-    assert "override 'cone'" in issues[0].message
+def test_an_area_model_override_keeps_point_contacts_point_contacts(tmp_path):
+    loaded = load_problem(_write(tmp_path, VALID), model="pyramid")
+    contacts = loaded.problem.contacts
+    assert [c.model for c in contacts] == ["pyramid", "pyramid", "point-pyramid"]
+    assert contacts[2].patch is None
+    cone = load_problem(_write(tmp_path, VALID), model="ellipsoid").problem.contacts
+    assert [c.model for c in cone] == ["ellipsoid", "ellipsoid", "point-cone"]
 
 
 def test_an_unknown_model_override_is_an_invalid_argument(tmp_path):
