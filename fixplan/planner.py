@@ -440,16 +440,19 @@ class Planner:
         magnitude = (
             np.abs(normal_part) + np.abs(friction_part) + np.abs(task_part) + np.abs(gravity)
         )
+        # Per load case: its forces and moments against the wrench terms of that case.
+        force_size = np.maximum(magnitude[:3].max(axis=0), 1e-12)
+        moment_size = np.maximum(magnitude[3:].max(axis=0), force_size * self.length_scale)
         relative = 0.0
-        force_size = max(float(magnitude[:3].max()), 1e-12)
-        sizes = (force_size, max(float(magnitude[3:].max()), force_size * self.length_scale))
-        for rows, unit, size in ((slice(0, 3), "N", sizes[0]), (slice(3, 6), "N m", sizes[1])):
-            worst = float(np.abs(residual[rows]).max())
-            relative = max(relative, worst / size)
-            if worst > EQUILIBRIUM_RTOL * size:
+        for rows, unit, size in ((slice(0, 3), "N", force_size), (slice(3, 6), "N m", moment_size)):
+            ratio = np.abs(residual[rows]).max(axis=0) / size
+            relative = max(relative, float(ratio.max()))
+            worst = int(np.argmax(ratio))
+            if ratio[worst] > EQUILIBRIUM_RTOL:
                 problems.append(
-                    f"equilibrium residual {worst:.3g} {unit} exceeds {EQUILIBRIUM_RTOL:g} of the "
-                    f"wrenches involved ({size:.3g} {unit})"
+                    f"equilibrium residual of load case {worst + 1}: "
+                    f"{ratio[worst] * size[worst]:.3g} {unit}, over {EQUILIBRIUM_RTOL:g} of the "
+                    f"wrenches involved ({size[worst]:.3g} {unit})"
                 )
         scale_force = max(float(np.abs(normal).max()), 1e-12)
         for i, (contact, model) in enumerate(zip(self.problem.contacts, self.models, strict=True)):

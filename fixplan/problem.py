@@ -228,6 +228,12 @@ class Contact:
         else:
             if not hasattr(model, "constraints"):
                 raise ProblemError(f"{where}.model must be a model name or object, got {model!r}")
+            model_mu = getattr(model, "mu", self.mu)
+            if abs(model_mu - self.mu) > 1e-12 * self.mu:
+                raise ProblemError(
+                    f"{where}.mu is {self.mu} but its model object was built with mu = "
+                    f"{model_mu}; give the same friction coefficient to both"
+                )
             pyramid = False
         if not pyramid and (self.facets is not None or self.inscribed is not None):
             raise ProblemError(f"{where}.facets and .inscribed are only for pyramid models")
