@@ -26,6 +26,7 @@ from fixplan.ellipsoid_models import (
 )
 from fixplan.errors import InvalidArgumentError
 from fixplan.model_base import FrictionModel, facet_count, fmt, polygon_normals
+from fixplan.tolerances import TILT_ATOL
 
 if TYPE_CHECKING:  # pragma: no cover
     from fixplan.limit_surface import LimitSurface
@@ -59,6 +60,11 @@ class Cone(FrictionModel):
         Centre of pressure [m] about which the moments are taken.
     normal_force : float
         Default normal force of the numeric methods [N].
+    apex_on_surface : bool
+        Whether the apexes ``±(t, 1)`` are the loads at maximum moment of the contact's limit
+        surface. Only then is the cone conservative: an untilted cone of a skewed pressure
+        field has its apexes outside the surface. :meth:`from_limit_surface` sets it; with
+        :meth:`from_limits` it is the caller's claim that ``apex_force`` is the true one.
     """
 
     mu: float
@@ -66,16 +72,20 @@ class Cone(FrictionModel):
     tilt: tuple[float, float] = (0.0, 0.0)
     center: tuple[float, float] = (0.0, 0.0)
     normal_force: float = 1.0
-
-    conservative: ClassVar[bool] = True
+    apex_on_surface: bool = True
 
     def __post_init__(self):
         check_area(self)
 
+    @property
+    def conservative(self) -> bool:  # type: ignore[override]
+        """True when the apexes are the surface's loads at maximum moment."""
+        return self.apex_on_surface
+
     @classmethod
     def from_limit_surface(cls, ls: LimitSurface, *, tilted: bool = True) -> Cone:
         """The cone of an exact limit surface (tilted through its load at maximum moment)."""
-        return cls(**area_parameters(ls, tilted))
+        return cls(**area_parameters(ls, tilted), apex_on_surface=_apex_on_surface(ls, tilted))
 
     @classmethod
     def from_limits(
@@ -104,7 +114,17 @@ class Cone(FrictionModel):
         return [cp.norm(force, 2) + cp.abs(q[2]) <= normal_force]
 
     def __repr__(self) -> str:
-        return area_repr(self)
+        return area_repr(self, _apex_note(self))
+
+
+def _apex_note(model) -> str:
+    """Repr fragment flagging apexes off the limit surface (not conservative)."""
+    return "" if model.apex_on_surface else "apex off the surface, "
+
+
+def _apex_on_surface(ls: LimitSurface, tilted: bool) -> bool:
+    """Whether a (possibly untilted) cone of ``ls`` has its apexes on the surface."""
+    return tilted or max(abs(t) for t in area_parameters(ls, True)["tilt"]) <= TILT_ATOL
 
 
 def _apothem(facets: int, inscribed: bool) -> float:
@@ -146,6 +166,8 @@ class Pyramid(FrictionModel):
         Number of facets ``k >= 3`` of the force polygon.
     inscribed : bool
         Polygon inside the circle (conservative) or about it.
+    apex_on_surface : bool
+        As for :class:`Cone`.
     """
 
     mu: float
@@ -155,6 +177,7 @@ class Pyramid(FrictionModel):
     facets: int = 4
     inscribed: bool = True
     normal_force: float = 1.0
+    apex_on_surface: bool = True
     _rows: np.ndarray = field(init=False, compare=False)
 
     def __post_init__(self):
@@ -174,15 +197,21 @@ class Pyramid(FrictionModel):
 
     @property
     def conservative(self) -> bool:  # type: ignore[override]
-        """True for the inscribed pyramid (inside the cone, hence inside the surface)."""
-        return self.inscribed
+        """True for the inscribed pyramid whose apexes are on the surface (inside the cone,
+        hence inside the surface)."""
+        return self.inscribed and self.apex_on_surface
 
     @classmethod
     def from_limit_surface(
         cls, ls: LimitSurface, *, facets: int = 4, inscribed: bool = True, tilted: bool = True
     ) -> Pyramid:
         """The pyramid of an exact limit surface (tilted through its load at maximum moment)."""
-        return cls(facets=facets, inscribed=inscribed, **area_parameters(ls, tilted))
+        return cls(
+            facets=facets,
+            inscribed=inscribed,
+            apex_on_surface=_apex_on_surface(ls, tilted),
+            **area_parameters(ls, tilted),
+        )
 
     @classmethod
     def from_limits(
@@ -224,7 +253,7 @@ class Pyramid(FrictionModel):
 
     def __repr__(self) -> str:
         kind = "inscribed" if self.inscribed else "circumscribed"
-        return area_repr(self, f"facets={self.facets}, {kind}, ")
+        return area_repr(self, f"facets={self.facets}, {kind}, {_apex_note(self)}")
 
 
 def _point_mu(ls: LimitSurface) -> tuple[float, float]:

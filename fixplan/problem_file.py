@@ -305,9 +305,16 @@ def _suggestion(word: str, allowed: Sequence[str]) -> str | None:
 def _finite(value: object) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise _InvalidValueError(f"expected a number, got {_describe(value)}")
-    if not math.isfinite(value):
+    try:
+        number = float(value)  # TOML integers have no size limit
+    except OverflowError:
+        raise _InvalidValueError(
+            f"expected a finite number, got an integer too large for a float ({len(str(value))} "
+            "digits)"
+        ) from None
+    if not math.isfinite(number):
         raise _InvalidValueError(f"expected a finite number, got {value}")
-    return float(value)
+    return number
 
 
 @dataclass(frozen=True, slots=True)
@@ -838,9 +845,13 @@ def _check_grid_shape(rows: list[list[float]], nx: int, ny: int) -> None:
 
 
 def _csv_rows(file: Path) -> list[list[float]]:
-    """The numbers of a CSV file, one list per non-blank row."""
+    """The numbers of a CSV file, one list per non-blank row.
+
+    A byte-order mark and empty cells at the end of a row (a trailing comma), which tactile
+    array software often writes, are ignored.
+    """
     try:
-        text = file.read_text(encoding="utf-8")
+        text = file.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as exc:
         reason = exc.strerror or str(exc) if isinstance(exc, OSError) else "not UTF-8 text"
         raise _InvalidValueError(f"cannot read the CSV file {str(file)!r}: {reason}") from None
@@ -849,6 +860,8 @@ def _csv_rows(file: Path) -> list[list[float]]:
     for row in reader:
         if not any(cell.strip() for cell in row):
             continue
+        while not row[-1].strip():
+            row = row[:-1]
         numbers = []
         for column, cell in enumerate(row, start=1):
             try:

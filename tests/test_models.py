@@ -457,3 +457,16 @@ def test_point_models_must_sit_at_the_centre_of_pressure():
     for build in (PointCone.from_limit_surface, PointPyramid.from_limit_surface):
         with pytest.raises(InvalidArgumentError, match="not its centre of pressure"):
             build(ls)
+
+
+@pytest.mark.parametrize("build", [Cone.from_limit_surface, Pyramid.from_limit_surface])
+def test_an_untilted_cone_of_skewed_pressure_is_not_flagged_conservative(build):
+    # Skewed points: the load at maximum moment has a force, so the untilted apex (0, m_max)
+    # lies outside the exact surface.
+    ls = LimitSurface(pressure.points([[0, 0], [0.03, 0], [0, 0.01]], [1, 2, 3]), mu=0.5,
+                      normal_force=7.0)  # fmt: skip
+    untilted, tilted = build(ls, tilted=False), build(ls)
+    assert tilted.conservative and not untilted.conservative
+    assert "apex off the surface" in repr(untilted)
+    apex = np.array([0.0, 0.0, untilted.max_moment])
+    assert untilted.contains(apex) and not ls.contains(apex)

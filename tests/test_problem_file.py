@@ -167,6 +167,14 @@ def test_grid_values_are_read_from_a_csv_file_next_to_the_problem_file(tmp_path,
     np.testing.assert_array_equal(patch.values, [[1.0, 2.0, 1.0], [0.5, 1.0, 0.5]])
 
 
+def test_a_csv_with_a_byte_order_mark_and_trailing_commas_is_read(tmp_path):
+    (tmp_path / "map.csv").write_text("\ufeff1, 2, 1,\n0.5, 1.0, 0.5,\n", encoding="utf-8")
+    grid = 'patch = { shape = "grid", x = [-0.01, 0.0, 0.01], y = [-0.005, 0.005], values = "map.csv" }'
+    text = _edited(VALID, ('patch = { shape = "disk", radius = 0.01, pressure = "hertz" }', grid))
+    patch = load_problem(_write(tmp_path, text)).problem.contacts[1].patch
+    np.testing.assert_array_equal(patch.values, [[1.0, 2.0, 1.0], [0.5, 1.0, 0.5]])
+
+
 def test_grid_values_may_be_given_inline(tmp_path):
     grid = 'patch = { shape = "grid", x = [0.0, 0.01], y = [0.0, 0.01], values = [[1, 2], [3, 4]] }'
     text = _edited(VALID, ('patch = { shape = "disk", radius = 0.01, pressure = "hertz" }', grid))
@@ -571,3 +579,8 @@ def test_malformed_documents_raise_only_problem_file_errors(tmp_path, text):
     issues = _issues(tmp_path, text)
     assert issues
     assert all(isinstance(issue, Issue) and issue.message for issue in issues)
+
+
+def test_an_integer_too_large_for_a_float_is_an_issue_not_a_crash(tmp_path):
+    text = _edited(VALID, ("mass = 2.0", "mass = 1" + "0" * 400))
+    _assert_issue(_issues(tmp_path, text), "body.mass", "too large")
