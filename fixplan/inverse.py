@@ -92,7 +92,7 @@ def _newton_step(g, hess, b1, b2):
     return s1[:, None] * b1 + s2[:, None] * b2, decrement
 
 
-def _newton(z, e1, e2, active, terms, values) -> np.ndarray:
+def _newton(z, e1, e2, active, terms, values, *, kinks: bool = False) -> np.ndarray:
     """Damped Newton on the planes, in place on rows ``active`` of ``z``; True where stalled."""
     stalled = np.zeros(len(z), dtype=bool)
     for _ in range(INVERSE_MAX_ITERATIONS):
@@ -115,9 +115,9 @@ def _newton(z, e1, e2, active, terms, values) -> np.ndarray:
             t[idx[~ok]] *= 0.5
         moved = accepted & ~done
         z[active[moved]] = za[moved] + t[moved, None] * step[moved]
-        # Tiny accepted steps mean Newton is crawling into a kink: stop and let the facet test
-        # and the smoothing continuation take over.
-        crawling = moved & (t < _CRAWL)
+        # With point supports, tiny accepted steps mean Newton is crawling into a kink: stop
+        # and let the facet test and the smoothing continuation take over.
+        crawling = moved & (t < _CRAWL) if kinks else np.zeros_like(moved)
         stalled[active[~accepted | crawling]] = True
         active = active[moved & ~crawling]
     stalled[active] = True
@@ -141,10 +141,10 @@ def solve(
     z = direction / length[:, None]
 
     terms, values = _objective(kernel, scale, units)
-    stalled = _newton(z, e1, e2, np.arange(count), terms, values)
+    points, friction = kernel.facets
+    stalled = _newton(z, e1, e2, np.arange(count), terms, values, kinks=len(points) > 0)
     safety = values(z)
     on_facet = np.zeros(count, dtype=bool)
-    points, friction = kernel.facets
     if len(points):
         # Newton only stops short, or lands on a kink, next to a support point.
         _, slowest = slowest_points(points, friction, z / units, 1)
@@ -170,7 +170,10 @@ def _check_converged(z, e1, e2, loads, terms) -> None:
     if bad.size:
         raise ConvergenceError(
             f"the inverse map did not converge for load {loads[bad[0]].tolist()} (relative "
-            f"gradient {projected[bad[0]] / h[bad[0]]:.2g}); please report this load"
+            f"gradient {projected[bad[0]] / h[bad[0]]:.2g}). Pressure and friction functions "
+            "must be smooth over the patch: where mu or p jumps or has a kink (two materials, "
+            "a step in pressure), describe each smooth region as its own patch and sum them with "
+            "LimitSurface.combine. Otherwise, please report this load."
         )
 
 

@@ -72,7 +72,8 @@ class LimitSurface:
         Pressure distribution, normalised to unit total; coordinates [m].
     mu : float or callable
         Friction coefficient, a constant >= 0 or a function ``mu(x, y)`` of contact-frame
-        coordinates [m] returning arrays.
+        coordinates [m] returning arrays. A function must be smooth over the patch; a patch of
+        two materials is two patches summed with :meth:`combine`.
     normal_force : float
         Total normal force [N], > 0.
     """

@@ -547,3 +547,27 @@ def test_bad_api_input_raises_an_error_naming_the_argument(name):
     assert isinstance(caught.value, ValueError)
     for word in words:
         assert word in str(caught.value), f"{word!r} missing from {caught.value}"
+
+
+def test_two_halves_combined_are_the_whole_rectangle():
+    whole = LimitSurface(pressure.rectangle(0.04, 0.01), mu=0.5, normal_force=7.0)
+    halves = LimitSurface.combine(
+        [
+            LimitSurface(pressure.rectangle(0.02, 0.01).shifted(x, 0.0), mu=0.5, normal_force=3.5)
+            for x in (-0.01, 0.01)
+        ]
+    )
+    loads = whole.sample(50)
+    assert np.max(np.abs(halves.safety_factor(loads) - 1.0)) <= 1e-12
+
+
+@pytest.mark.parametrize("aspect", [100, 1000])
+def test_very_thin_rectangles_invert_near_translation_across_their_long_side(aspect):
+    surface = LimitSurface(pressure.rectangle(1.0, 1.0 / aspect), mu=0.5, normal_force=7.0)
+    twists = np.array([[0.01, 1.0, 0.2], [-0.02, -1.0, 0.5], [0.0, 1.0, -1.0]])
+    motions, safety = surface.motion_and_safety_factor(surface.load(twists))
+    assert np.max(np.abs(safety - 1.0)) <= 1e-9
+    scale = np.array([1.0, 1.0, surface.characteristic_length])
+    a, b = motions * scale, twists * scale
+    sine = np.linalg.norm(np.cross(a, b), axis=1) / np.linalg.norm(a, axis=1)
+    assert np.max(sine / np.linalg.norm(b, axis=1)) <= 1e-8
