@@ -355,21 +355,11 @@ def contact_section_figure(
     if len(axes) != 3:
         raise InvalidArgumentError(f"axes must hold 3 Axes, got {len(axes)}")
     for ax, curve, (_, a, b) in zip(axes, data.curves, _SECTION_PLANES, strict=True):
-        closed = np.vstack([curve, curve[:1]])
-        ax.fill(*closed.T, color="tab:blue", alpha=0.12)
-        ax.plot(*closed.T, color="tab:blue", linewidth=1.5, label="friction set")
         ray = data.limit[[a, b]]
-        if np.all(np.isfinite(ray)):
-            ax.plot([0.0, ray[0]], [0.0, ray[1]], color="0.5", linewidth=0.8, linestyle="--")
-            ax.plot(
-                *ray,
-                marker="x",
-                color="tab:red",
-                markersize=8,
-                linestyle="none",
-                label=r"load $\times$ safety factor",
-            )
-        ax.plot(*data.load[[a, b]], marker="o", color="black", linestyle="none", label="load")
+        _draw_section(
+            ax, curve, "tab:blue", "friction set", data.load[[a, b]],
+            ray if np.all(np.isfinite(ray)) else None,
+        )  # fmt: skip
         reach = np.abs(np.concatenate([data.load, np.nan_to_num(data.limit)]))
         limit = 1.15 * max(1.0, float(reach.max()))
         ax.set_xlim(-limit, limit)
@@ -549,23 +539,12 @@ def contact_set_figure(
     if len(axes) != len(data.pairs):
         raise InvalidArgumentError(f"axes must hold {len(data.pairs)} Axes, got {len(axes)}")
     for ax, pair, curve in zip(axes, data.pairs, data.curves, strict=True):
-        closed = np.vstack([curve, curve[:1]])
-        ax.fill(*closed.T, color="tab:purple", alpha=0.12)
-        ax.plot(*closed.T, color="tab:purple", linewidth=1.5, label="limit surface section")
         index = [data.subspace.index(c) for c in pair]
-        if data.load is not None:
-            if data.limit is not None:
-                ray = data.limit[index]
-                ax.plot([0.0, ray[0]], [0.0, ray[1]], color="0.5", linewidth=0.8, linestyle="--")
-                ax.plot(
-                    *ray,
-                    marker="x",
-                    color="tab:red",
-                    markersize=8,
-                    linestyle="none",
-                    label=r"load $\times$ safety factor",
-                )
-            ax.plot(*data.load[index], marker="o", color="black", linestyle="none", label="load")
+        _draw_section(
+            ax, curve, "tab:purple", "limit surface section",
+            None if data.load is None else data.load[index],
+            None if data.load is None or data.limit is None else data.limit[index],
+        )  # fmt: skip
         ax.axhline(0.0, color="0.8", linewidth=0.6)
         ax.axvline(0.0, color="0.8", linewidth=0.6)
         ax.set_xlabel(f"{pair[0]} [{_unit(pair[0])}]")
@@ -639,3 +618,18 @@ def surface_figure(surface: LimitSurface, models: dict, *, axes=None) -> Figure:
 def _closed(curve: np.ndarray) -> np.ndarray:
     """``curve`` with its first point repeated at the end (a closed line)."""
     return np.vstack([curve, curve[:1]])
+
+
+def _draw_section(ax, curve, color, label, load, limit) -> None:
+    """A closed, shaded section ``curve`` ``(n, 2)``, the load in it (``None``: no load) and
+    the point where the load's ray leaves it (``None``: not drawn)."""
+    closed = _closed(curve)
+    ax.fill(*closed.T, color=color, alpha=0.12)
+    ax.plot(*closed.T, color=color, linewidth=1.5, label=label)
+    if load is None:
+        return
+    if limit is not None:
+        ax.plot([0.0, limit[0]], [0.0, limit[1]], color="0.5", linewidth=0.8, linestyle="--")
+        ax.plot(*limit, marker="x", color="tab:red", markersize=8, linestyle="none",
+                label=r"load $\times$ safety factor")  # fmt: skip
+    ax.plot(*load, marker="o", color="black", linestyle="none", label="load")
