@@ -12,8 +12,8 @@ import time
 import numpy as np
 
 from fixplan import pressure
-from fixplan.planner import Planner
-from fixplan.problem import Body, Contact, Load, Problem
+from fixplan.planner.planner import Planner
+from fixplan.planner.problem import Body, Contact, Load, Problem
 
 
 def fixture(model: str, objective: str, loads: list[Load], clamp_force: float | None = None):

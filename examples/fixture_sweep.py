@@ -30,8 +30,8 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from fixplan.planner import Planner
-from fixplan.problem_file import load_problem
+from fixplan.io.problem_file import load_problem
+from fixplan.planner.planner import Planner
 
 ROOT = Path(__file__).resolve().parent.parent
 PROBLEM_FILE = ROOT / "problems" / "fixture-321.toml"

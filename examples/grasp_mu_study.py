@@ -38,8 +38,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from fixplan import pressure
-from fixplan.planner import Planner
-from fixplan.problem import Body, Contact, Load, Problem
+from fixplan.planner.planner import Planner
+from fixplan.planner.problem import Body, Contact, Load, Problem
 
 MASS = 0.25  # [kg]
 GRAVITY = 9.81  # [m/s²]

@@ -5,30 +5,55 @@ exact limit surfaces of planar contacts for any pressure distribution (:class:`L
 :mod:`fixplan.pressure`), the paper's approximations with their errors measured
 (:mod:`fixplan.models`, :mod:`fixplan.compare`), and a convex planner built on them
 (:class:`Problem`, :func:`solve`).
+
+The package is layered; each subpackage imports only from those below it::
+
+    io/        problem files, reports, figures, command line
+    planner/   problems -> stacked convex problem -> verified plans, motions, certificates
+    models/    friction models (ellipsoid family, cones, pyramids, exact) and compare
+    surface/   pressure fields -> exact limit surface (support, forward and inverse maps)
+    errors, tolerances, validation
+
+Public names are loaded on first use, so that ``import fixplan`` (and ``fixplan --help``) does
+not import the solver stack.
 """
 
-from importlib.metadata import PackageNotFoundError, version
+from __future__ import annotations
 
-from fixplan import compare, models, pressure
-from fixplan.contact_surface import ContactSetSurface
-from fixplan.errors import (
-    ConvergenceError,
-    FixplanError,
-    GeometryError,
-    InvalidArgumentError,
-    ModelError,
-)
-from fixplan.limit_surface import LimitSurface
-from fixplan.plan import Plan
-from fixplan.planner import Planner, solve
-from fixplan.problem import Body, Contact, Load, Problem, ProblemError
-from fixplan.problem_file import ProblemFileError, load_problem
-from fixplan.screw import Screw
+import importlib
+from importlib.metadata import PackageNotFoundError, version
 
 try:
     __version__ = version("fixplan")
 except PackageNotFoundError:  # pragma: no cover - running from a source tree
     __version__ = "0.0.0+unknown"
+
+#: Public name -> module that defines it (a module itself where the name is a module).
+_EXPORTS = {
+    "Body": "fixplan.planner.problem",
+    "Contact": "fixplan.planner.problem",
+    "ContactSetSurface": "fixplan.planner.contact_surface",
+    "ConvergenceError": "fixplan.errors",
+    "FixplanError": "fixplan.errors",
+    "GeometryError": "fixplan.errors",
+    "InvalidArgumentError": "fixplan.errors",
+    "LimitSurface": "fixplan.surface.limit_surface",
+    "Load": "fixplan.planner.problem",
+    "ModelError": "fixplan.errors",
+    "Plan": "fixplan.planner.plan",
+    "Planner": "fixplan.planner.planner",
+    "Problem": "fixplan.planner.problem",
+    "ProblemError": "fixplan.planner.problem",
+    "ProblemFileError": "fixplan.io.problem_file",
+    "Screw": "fixplan.planner.screw",
+    "load_problem": "fixplan.io.problem_file",
+    "solve": "fixplan.planner.planner",
+}
+_MODULES = {
+    "compare": "fixplan.models.compare",
+    "models": "fixplan.models",
+    "pressure": "fixplan.surface.pressure",
+}
 
 __all__ = [
     "Body",
@@ -54,3 +79,18 @@ __all__ = [
     "pressure",
     "solve",
 ]
+
+
+def __getattr__(name: str):
+    if name in _MODULES:
+        value = importlib.import_module(_MODULES[name])
+    elif name in _EXPORTS:
+        value = getattr(importlib.import_module(_EXPORTS[name]), name)
+    else:
+        raise AttributeError(f"module 'fixplan' has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -3,7 +3,7 @@ the laws every surface obeys and of the inverse map.
 
 The catalogue spans SI scales of real contacts (millimetre fingertips to 10 cm fixture pads,
 normal forces from 0.5 N to 200 N) so that unit mistakes show up. The last entries need
-``fixplan.function_kernel`` (pressure functions, position-dependent friction on continuous
+``fixplan.surface.function_kernel`` (pressure functions, position-dependent friction on continuous
 fields).
 """
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from fixplan import __version__
-from fixplan.cli import (
+from fixplan.io.cli import (
     EXIT_INVALID_INPUT,
     EXIT_NOT_HELD,
     EXIT_OK,
@@ -166,7 +166,7 @@ def test_compare_tabulates_every_applicable_model(tmp_path, capsys):
 
 def test_help_starts_with_an_example_and_lists_exit_codes():
     result = subprocess.run(
-        [sys.executable, "-m", "fixplan.cli", "--help"], capture_output=True, text=True
+        [sys.executable, "-m", "fixplan.io.cli", "--help"], capture_output=True, text=True
     )
     assert result.returncode == 0
     assert result.stdout.splitlines()[1].strip() == "example:" or "example:" in result.stdout[:200]
@@ -175,14 +175,14 @@ def test_help_starts_with_an_example_and_lists_exit_codes():
 
 def test_version_is_printed():
     result = subprocess.run(
-        [sys.executable, "-m", "fixplan.cli", "--version"], capture_output=True, text=True
+        [sys.executable, "-m", "fixplan.io.cli", "--version"], capture_output=True, text=True
     )
     assert result.stdout.strip() == f"fixplan {__version__}"
 
 
 def test_results_go_to_stdout_and_nothing_else_to_it_when_quiet(tmp_path):
     result = subprocess.run(
-        [sys.executable, "-m", "fixplan.cli", "plan", str(write(tmp_path)), "--json", "-q"],
+        [sys.executable, "-m", "fixplan.io.cli", "plan", str(write(tmp_path)), "--json", "-q"],
         capture_output=True, text=True,
     )  # fmt: skip
     json.loads(result.stdout)

@@ -1,6 +1,6 @@
 """The paper's accuracy claims (§2.4, §4.2, Figs. 3 and 5), reproduced with numbers.
 
-Every number asserted here was computed by fixplan.compare and, for the disks of Fig. 3,
+Every number asserted here was computed by fixplan.models.compare and, for the disks of Fig. 3,
 checked against the closed forms of DESIGN.md §4, written out below independently of the
 library. Radial errors are relative (``e = r_model / r_exact - 1``, ``e > 0`` unsafe); angles
 are in radians.
@@ -13,9 +13,9 @@ import pytest
 from scipy.special import ellipe, ellipk
 
 from fixplan import LimitSurface, pressure
-from fixplan.compare import Accuracy, accuracy_table, compare, load_directions, radial_errors
 from fixplan.errors import InvalidArgumentError
 from fixplan.models import Cone, Ellipsoid, Exact, FittedEllipsoid, PointCone, PointPyramid, Pyramid
+from fixplan.models.compare import Accuracy, accuracy_table, compare, load_directions, radial_errors
 from fixplan.tolerances import UNSAFE_RTOL
 
 MU, N, R = 0.5, 2.0, 0.01

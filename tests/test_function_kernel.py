@@ -15,12 +15,12 @@ import numpy as np
 import pytest
 from scipy.integrate import quad_vec
 
-from fixplan.disk_kernel import DiskKernel
-from fixplan.function_kernel import FunctionKernel
-from fixplan.geometry import signed_area, triangulate
-from fixplan.point_kernel import PointSetKernel
-from fixplan.polygon_kernel import EdgeSumKernel, polygon_edges
-from fixplan.rules import triangle_rule
+from fixplan.surface.disk_kernel import DiskKernel
+from fixplan.surface.function_kernel import FunctionKernel
+from fixplan.surface.geometry import signed_area, triangulate
+from fixplan.surface.point_kernel import PointSetKernel
+from fixplan.surface.polygon_kernel import EdgeSumKernel, polygon_edges
+from fixplan.surface.rules import triangle_rule
 
 SMOOTH = 1e-9  # relative accuracy required for smooth fields
 HERTZ = 1e-7  # ... and for the Hertz profile (square-root edge)

@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 
 from fixplan import LimitSurface, pressure
-from fixplan.compare import compare
 from fixplan.errors import FixplanError, InvalidArgumentError, ModelError
 from fixplan.models import (
     Cone,
@@ -19,6 +18,7 @@ from fixplan.models import (
     PointPyramid,
     Pyramid,
 )
+from fixplan.models.compare import compare
 
 MU, N = 0.5, 4.0
 RADIUS = 0.01

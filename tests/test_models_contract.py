@@ -17,7 +17,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fixplan import LimitSurface, pressure
-from fixplan.compare import compare
 from fixplan.errors import InvalidArgumentError, ModelError
 from fixplan.models import (
     MODEL_CLASSES,
@@ -31,6 +30,7 @@ from fixplan.models import (
     PointPyramid,
     Pyramid,
 )
+from fixplan.models.compare import compare
 from fixplan.tolerances import UNSAFE_RTOL
 
 MU = 0.4

@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 from fixplan import LimitSurface, pressure
-from fixplan.contact_models import contact_model
-from fixplan.contact_surface import ContactSetSurface
 from fixplan.errors import FixplanError, InvalidArgumentError
 from fixplan.models import Ellipsoid
-from fixplan.planner import Planner, solve
-from fixplan.problem import Body, Contact, Load, Problem, ProblemError
+from fixplan.planner.contact_models import contact_model
+from fixplan.planner.contact_surface import ContactSetSurface
+from fixplan.planner.planner import Planner, solve
+from fixplan.planner.problem import Body, Contact, Load, Problem, ProblemError
 
 MU, RADIUS, HALF_GAP = 0.5, 0.01, 0.02
 WEIGHTLESS = Body(mass=0.0, center_of_mass=[0, 0, 0])

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from fixplan.errors import FixplanError, InvalidArgumentError
-from fixplan.pressure import DiskField, GridField, PolygonField
-from fixplan.problem_file import Issue, ProblemFile, ProblemFileError, load_problem
+from fixplan.io.problem_file import Issue, ProblemFile, ProblemFileError, load_problem
+from fixplan.surface.pressure import DiskField, GridField, PolygonField
 
 HEADER = """\
 schema_version = 1

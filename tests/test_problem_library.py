@@ -20,11 +20,11 @@ import numpy as np
 import pytest
 
 from fixplan import LimitSurface, pressure
-from fixplan.cli import EXIT_NOT_HELD, EXIT_OK, main
-from fixplan.contact_models import contact_model
-from fixplan.planner import Planner
-from fixplan.problem import MODEL_NAMES
-from fixplan.problem_file import load_problem
+from fixplan.io.cli import EXIT_NOT_HELD, EXIT_OK, main
+from fixplan.io.problem_file import load_problem
+from fixplan.planner.contact_models import contact_model
+from fixplan.planner.planner import Planner
+from fixplan.planner.problem import MODEL_NAMES
 
 ROOT = Path(__file__).resolve().parents[1]
 PROBLEMS = ROOT / "problems"

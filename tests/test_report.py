@@ -22,14 +22,14 @@ from matplotlib.figure import Figure
 
 import fixplan
 from fixplan import pressure
-from fixplan.contact_models import contact_model
 from fixplan.errors import InvalidArgumentError
-from fixplan.figures import contact_section_figure, layout_figure, safety_figure
-from fixplan.plan import Plan
-from fixplan.planner import Planner
-from fixplan.problem import Body, Contact, Load, Problem
-from fixplan.problem_file import load_problem
-from fixplan.report import default_sliding_subspace, write_report
+from fixplan.io.figures import contact_section_figure, layout_figure, safety_figure
+from fixplan.io.problem_file import load_problem
+from fixplan.io.report import default_sliding_subspace, write_report
+from fixplan.planner.contact_models import contact_model
+from fixplan.planner.plan import Plan
+from fixplan.planner.planner import Planner
+from fixplan.planner.problem import Body, Contact, Load, Problem
 
 MU = 0.3
 CLAMPS = {"clamp-east": [0.03, 0.0, 0.04], "clamp-west": [-0.03, 0.0, 0.04]}

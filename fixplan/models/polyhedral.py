@@ -15,7 +15,9 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 
 from fixplan import validation
-from fixplan.ellipsoid_models import (
+from fixplan.errors import InvalidArgumentError
+from fixplan.models.base import FrictionModel, facet_count, fmt, polygon_normals
+from fixplan.models.ellipsoid import (
     _shear,
     area_parameters,
     area_repr,
@@ -24,12 +26,10 @@ from fixplan.ellipsoid_models import (
     surface_axis,
     surface_units,
 )
-from fixplan.errors import InvalidArgumentError
-from fixplan.model_base import FrictionModel, facet_count, fmt, polygon_normals
 from fixplan.tolerances import TILT_ATOL
 
 if TYPE_CHECKING:  # pragma: no cover
-    from fixplan.limit_surface import LimitSurface
+    from fixplan.surface.limit_surface import LimitSurface
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, repr=False)

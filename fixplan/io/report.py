@@ -7,7 +7,7 @@
   objective, active forces, safety factors per load case, the impending motions in words, the
   infeasibility certificate when there is one, and the figures;
 - ``plan.json``: :meth:`Plan.as_dict` with sorted keys;
-- PNG figures (:mod:`fixplan.figures`): ``layout.png``, ``safety-factors.png``,
+- PNG figures (:mod:`fixplan.io.figures`): ``layout.png``, ``safety-factors.png``,
   ``contact-NN-NAME.png`` per loaded area contact and ``contact-set.png``.
 
 The report is built once as a list of blocks (headings, paragraphs, tables, lists, images) and
@@ -31,13 +31,13 @@ import cvxpy
 import numpy as np
 
 import fixplan
-from fixplan import figures
-from fixplan.contact_surface import COMPONENTS, ContactSetSurface
 from fixplan.errors import FixplanError, InvalidArgumentError
-from fixplan.plan import Plan
-from fixplan.planner import Planner
-from fixplan.problem import FIXED_FORCE_OBJECTIVES, PASSIVE_ROLES, Problem
-from fixplan.problem_file import ProblemFile
+from fixplan.io import figures
+from fixplan.io.problem_file import ProblemFile
+from fixplan.planner.contact_surface import COMPONENTS, ContactSetSurface
+from fixplan.planner.plan import Plan
+from fixplan.planner.planner import Planner
+from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, PASSIVE_ROLES, Problem
 
 #: A contact whose normal force is at most this fraction of the largest normal force of its load
 #: case carries no load: its section figure is skipped (its friction set is a point).

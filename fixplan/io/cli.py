@@ -18,9 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from fixplan import __version__, pressure
+from fixplan import __version__
 from fixplan.errors import ConvergenceError, FixplanError, InvalidArgumentError
-from fixplan.problem import MODEL_NAMES
+from fixplan.planner.problem import MODEL_NAMES
+from fixplan.surface import pressure
 
 EXIT_OK = 0
 EXIT_UNEXPECTED = 1
@@ -220,20 +221,20 @@ def _summary(problem_file, plan) -> str:
 
 
 def _load(file: Path, model: str | None = None):
-    from fixplan.problem_file import load_problem
+    from fixplan.io.problem_file import load_problem
 
     return load_problem(file, model=model)
 
 
 def _run_plan(args: argparse.Namespace) -> int:
-    from fixplan.planner import Planner
+    from fixplan.planner.planner import Planner
 
     problem_file = _load(args.file, args.model)
     planner = Planner(problem_file.problem, solver=args.solver)
     log.info("solving %s (%d load cases)", args.file, len(problem_file.problem.loads))
     plan = planner.solve(progress=_Progress("solving", not args.quiet))
     if args.report is not None:
-        from fixplan.report import write_report
+        from fixplan.io.report import write_report
 
         written = write_report(args.report, problem_file, plan, planner)
         log.info("wrote %d report files to %s", len(written), args.report)
@@ -296,14 +297,14 @@ def _percent(fraction: float) -> float:
 
 
 def _run_surface(args: argparse.Namespace) -> int:
-    from fixplan.compare import compare
-    from fixplan.limit_surface import LimitSurface
+    from fixplan.models.compare import compare
+    from fixplan.surface.limit_surface import LimitSurface
 
     surface = LimitSurface(_patch(args), mu=args.mu, normal_force=args.normal_force)
     models = _surface_models(surface)
     accuracy = {name: compare(model, surface, n=1000) for name, model in models.items()}
     if args.plot is not None:
-        from fixplan.figures import save_png, surface_figure
+        from fixplan.io.figures import save_png, surface_figure
 
         save_png(surface_figure(surface, models), args.plot)
         log.info("wrote %s", args.plot)
@@ -358,7 +359,7 @@ def _compare_models(problem) -> list[str]:
 
 
 def _run_compare(args: argparse.Namespace) -> int:
-    from fixplan.planner import Planner
+    from fixplan.planner.planner import Planner
 
     base = _load(args.file)
     models = _compare_models(base.problem)

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import ellipe, ellipk, hyp2f1, poch
 
-from fixplan.kernels import SupportKernel
+from fixplan.surface.kernels import SupportKernel
 
 #: ``c`` of ``₂F₁(-1/2, -1/2; c; x)`` giving ``M(ρ)/ρ`` outside the disk, per profile.
 _OUTSIDE_C = {"uniform": 2.0, "hertz": 2.5, "parabolic": 3.0, "ring": 1.0}

@@ -22,9 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from fixplan.errors import InvalidArgumentError
-from fixplan.limit_surface import LimitSurface
-from fixplan.model_base import FrictionModel
-from fixplan.sphere import circle, fibonacci_sphere
+from fixplan.models.base import FrictionModel
+from fixplan.surface.limit_surface import LimitSurface
+from fixplan.surface.sphere import circle, fibonacci_sphere
 from fixplan.tolerances import UNSAFE_RTOL
 
 _PLANES = {"fx-m": (0, 2), "fy-m": (1, 2), "fx-fy": (0, 1)}

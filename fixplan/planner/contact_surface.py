@@ -19,10 +19,10 @@ from collections.abc import Sequence
 import cvxpy as cp
 import numpy as np
 
-from fixplan.contact_models import contact_model
 from fixplan.errors import FixplanError, InvalidArgumentError
-from fixplan.problem import Contact
-from fixplan.sphere import circle, fibonacci_sphere
+from fixplan.planner.contact_models import contact_model
+from fixplan.planner.problem import Contact
+from fixplan.surface.sphere import circle, fibonacci_sphere
 
 COMPONENTS = ("fx", "fy", "fz", "mx", "my", "mz")
 _OPTIONS = {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9}

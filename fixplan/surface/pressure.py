@@ -27,8 +27,14 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import GeometryError, InvalidArgumentError
-from fixplan.geometry import Pose, polygon_centroid, signed_area, simple_polygon, triangulate
-from fixplan.rules import gauss_jacobi_unit, triangle_rule
+from fixplan.surface.geometry import (
+    Pose,
+    polygon_centroid,
+    signed_area,
+    simple_polygon,
+    triangulate,
+)
+from fixplan.surface.rules import gauss_jacobi_unit, triangle_rule
 
 DISK_PROFILES = ("uniform", "hertz", "parabolic", "annulus", "ring")
 

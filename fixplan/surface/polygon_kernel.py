@@ -22,8 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fixplan.kernels import SupportKernel
-from fixplan.point_kernel import PointSetKernel
+from fixplan.surface.kernels import SupportKernel
+from fixplan.surface.point_kernel import PointSetKernel
 from fixplan.tolerances import FAR_FIELD_RADII
 
 

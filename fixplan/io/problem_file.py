@@ -1,4 +1,4 @@
-"""Problem files: a fixture or grasp problem in TOML, read into a :class:`~fixplan.problem.Problem`.
+"""Problem files: a fixture or grasp problem in TOML, read into a :class:`~fixplan.planner.problem.Problem`.
 
 :func:`load_problem` checks the whole file before it builds anything and reports every mistake
 at once in a :class:`ProblemFileError`, one :class:`Issue` per mistake, each with the key path
@@ -8,7 +8,7 @@ SI throughout. The schema::
     schema_version = 1                    # required, must be 1
     name = "vise-milling"                 # required
     kind = "fixture"                      # "fixture" or "grasp"; required
-    objective = "min-total-clamp-force"   # required; one of fixplan.problem.OBJECTIVES
+    objective = "min-total-clamp-force"   # required; one of fixplan.planner.problem.OBJECTIVES
     description = "..."                   # optional free text
 
     [defaults]                            # optional; mu, model, facets, inscribed
@@ -71,9 +71,9 @@ from pathlib import Path
 
 import numpy as np
 
-from fixplan import pressure, validation
+from fixplan import validation
 from fixplan.errors import FixplanError
-from fixplan.problem import (
+from fixplan.planner.problem import (
     AREA_MODEL_NAMES,
     MODEL_NAMES,
     OBJECTIVES,
@@ -84,6 +84,7 @@ from fixplan.problem import (
     Load,
     Problem,
 )
+from fixplan.surface import pressure
 
 #: The version of the schema this module reads.
 SCHEMA_VERSION = 1
@@ -224,7 +225,7 @@ def load_problem(path: str | os.PathLike[str], *, model: str | None = None) -> P
         The problem file.
     model : str, optional
         Friction model that replaces every contact's model (one of
-        :data:`fixplan.problem.MODEL_NAMES`). With an area model, contacts without a patch get
+        :data:`fixplan.planner.problem.MODEL_NAMES`). With an area model, contacts without a patch get
         its point version (:data:`POINT_VERSION`); ``facets`` and ``inscribed`` are dropped from
         contacts when the model is not a pyramid.
 

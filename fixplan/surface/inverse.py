@@ -20,8 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from fixplan.errors import ConvergenceError
-from fixplan.kernels import SupportKernel
-from fixplan.point_kernel import slowest_points
+from fixplan.surface.kernels import SupportKernel
+from fixplan.surface.point_kernel import slowest_points
 from fixplan.tolerances import (
     FACET_RTOL,
     INVERSE_GRADIENT_RTOL,

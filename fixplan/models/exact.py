@@ -24,11 +24,11 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError
-from fixplan.model_base import FrictionModel, fmt
-from fixplan.sphere import fibonacci_sphere
+from fixplan.models.base import FrictionModel, fmt
+from fixplan.surface.sphere import fibonacci_sphere
 
 if TYPE_CHECKING:  # pragma: no cover
-    from fixplan.limit_surface import LimitSurface
+    from fixplan.surface.limit_surface import LimitSurface
 
 #: Default quadrature order (Gauss nodes per dimension and panel): 128 points on a disk or a
 #: rectangle, a radial error of about 1e-3 (the tests measure it).
@@ -67,8 +67,8 @@ class Exact(FrictionModel):
     conservative: ClassVar[bool] = False
 
     def __post_init__(self):
-        from fixplan import pressure
-        from fixplan.limit_surface import LimitSurface
+        from fixplan.surface import pressure
+        from fixplan.surface.limit_surface import LimitSurface
 
         points = validation.finite_array("points", self.points, shape=(None, 2))
         capacity = validation.finite_array("capacity", self.capacity, shape=(len(points),))
@@ -94,7 +94,7 @@ class Exact(FrictionModel):
         Works for constant and position-dependent ``mu`` and for combined surfaces (the
         quadrature points of every part, weighted by its share of the normal force).
         """
-        from fixplan.ellipsoid_models import surface_units
+        from fixplan.models.ellipsoid import surface_units
 
         surface_units(ls)
         if isinstance(order, bool) or not isinstance(order, int | np.integer) or order < 1:
@@ -165,7 +165,7 @@ def _discretise(ls: LimitSurface, order: int) -> tuple[np.ndarray, np.ndarray]:
         points = np.concatenate([p for p, _ in pieces])
         capacity = np.concatenate([c * s for (_, c), s in zip(pieces, shares, strict=True)])
         return points, capacity
-    from fixplan.pressure import friction_values
+    from fixplan.surface.pressure import friction_values
 
     points, weights = ls.field.quadrature(order)
     friction = friction_values(ls.mu, points) if callable(ls.mu) else ls.mu

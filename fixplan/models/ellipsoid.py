@@ -15,12 +15,12 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import ConvergenceError, InvalidArgumentError
-from fixplan.model_base import FrictionModel, finite_pair, fmt
-from fixplan.sphere import fibonacci_sphere
+from fixplan.models.base import FrictionModel, finite_pair, fmt
+from fixplan.surface.sphere import fibonacci_sphere
 from fixplan.tolerances import FIT_MIN_EIGENVALUE, TILT_ATOL
 
 if TYPE_CHECKING:  # pragma: no cover
-    from fixplan.limit_surface import LimitSurface
+    from fixplan.surface.limit_surface import LimitSurface
 
 #: Default number of limit-surface samples an ellipsoid is fitted to.
 DEFAULT_FIT_SAMPLES = 1000
@@ -29,7 +29,7 @@ DEFAULT_FIT_SAMPLES = 1000
 def surface_units(ls: LimitSurface) -> tuple[float, float, float]:
     """``(mu, rho, normal_force)`` of a limit surface: friction per unit normal force [-],
     characteristic length [m] and normal force [N]."""
-    from fixplan.limit_surface import LimitSurface
+    from fixplan.surface.limit_surface import LimitSurface
 
     if not isinstance(ls, LimitSurface):
         raise InvalidArgumentError(

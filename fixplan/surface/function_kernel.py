@@ -39,7 +39,7 @@ for any ``d``, with a number of points that grows like ``log(1/d)``:
 
 Regions farther from ``c`` (and every region when ``w = 0``) use a fixed rule (triangle Gauss,
 polar tanh-sinh, trapezoidal) on which the integrand is analytic; it is precomputed with its
-``mu p`` values and summed by the compiled :class:`~fixplan.point_kernel.PointSetKernel`. The
+``mu p`` values and summed by the compiled :class:`~fixplan.surface.point_kernel.PointSetKernel`. The
 fixed rule also gives ``N``. Accuracy (relative, measured against closed forms and independent
 adaptive quadrature): ``1e-12`` or better for smooth fields and for the Hertz profile, for any
 centre of rotation.
@@ -55,10 +55,10 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError
-from fixplan.geometry import simple_polygon, triangulate
-from fixplan.kernels import SupportKernel
-from fixplan.point_kernel import PointSetKernel
-from fixplan.rules import gauss_jacobi_unit, tanh_sinh_unit, triangle_rule
+from fixplan.surface.geometry import simple_polygon, triangulate
+from fixplan.surface.kernels import SupportKernel
+from fixplan.surface.point_kernel import PointSetKernel
+from fixplan.surface.rules import gauss_jacobi_unit, tanh_sinh_unit, triangle_rule
 from fixplan.tolerances import FAR_FIELD_RADII
 
 REGION_KINDS = ("polygon", "disk", "circle")

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fixplan.geometry import Pose
+from fixplan.surface.geometry import Pose
 from fixplan.tolerances import HESSIAN_STEP
 
 

@@ -27,16 +27,16 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import FixplanError, InvalidArgumentError
-from fixplan.plan import Plan
-from fixplan.problem import Contact, Problem
+from fixplan.planner.plan import Plan
+from fixplan.planner.problem import Contact, Problem
 
 if TYPE_CHECKING:  # pragma: no cover - typing only; matplotlib is imported when drawing
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-    from fixplan.contact_surface import ContactSetSurface
-    from fixplan.limit_surface import LimitSurface
-    from fixplan.model_base import FrictionModel
+    from fixplan.models.base import FrictionModel
+    from fixplan.planner.contact_surface import ContactSetSurface
+    from fixplan.surface.limit_surface import LimitSurface
 
 #: Resolution of saved figures [dots per inch].
 DPI = 100

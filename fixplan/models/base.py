@@ -34,7 +34,7 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError, ModelError
-from fixplan.sphere import circle
+from fixplan.surface.sphere import circle
 from fixplan.tolerances import CONTAINMENT_RTOL
 
 if TYPE_CHECKING:  # pragma: no cover - typing only; cvxpy is imported when constraints are built

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from fixplan.kernels import SupportKernel
+from fixplan.surface.kernels import SupportKernel
 
 #: A point whose speed is below this fraction of the twist's scale at that point is stationary
 #: (the centre of rotation sits on it up to rounding): it carries no force in :func:`_evaluate`

@@ -14,7 +14,7 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError
-from fixplan.pressure import PressureField
+from fixplan.surface.pressure import PressureField
 
 ROLES = ("locator", "support", "clamp", "finger")
 PASSIVE_ROLES = ("locator", "support")

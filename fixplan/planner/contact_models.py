@@ -6,10 +6,10 @@ and ``mu``), so the torsional friction comes from the patch, never from a guesse
 
 from __future__ import annotations
 
-from fixplan.limit_surface import LimitSurface
-from fixplan.model_base import FrictionModel
 from fixplan.models import Cone, Ellipsoid, Exact, PointCone, PointPyramid, Pyramid
-from fixplan.problem import DEFAULT_FACETS, DEFAULT_INSCRIBED, Contact
+from fixplan.models.base import FrictionModel
+from fixplan.planner.problem import DEFAULT_FACETS, DEFAULT_INSCRIBED, Contact
+from fixplan.surface.limit_surface import LimitSurface
 
 #: Quadrature order of the "exact" model in the planner: 128 friction disks per disk or
 #: rectangle patch, about 1e-3 from the continuous surface (reported by the model).

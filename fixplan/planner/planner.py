@@ -11,7 +11,7 @@ to the body wrench about the world origin, ``F_i`` its friction model at unit no
 normal forces; the fixed-force objectives maximise each ``s_j``. The cvxpy problem is built once
 per structure with Parameters for the task wrenches, gravity and the fixed forces (it is DPP), so
 new load values re-solve without rebuilding; small problems re-solve straight through Clarabel
-(:mod:`fixplan.direct_solve`), large ones (the sum-of-disks model) skip cvxpy's DPP compilation,
+(:mod:`fixplan.planner.direct_solve`), large ones (the sum-of-disks model) skip cvxpy's DPP compilation,
 which costs more there than canonicalising afresh. The dual of the equilibrium constraint of a case is
 the twist in which the body starts to slide (maximum power); for an infeasible problem it is the
 motion that nothing resists.
@@ -27,12 +27,12 @@ from dataclasses import dataclass
 import cvxpy as cp
 import numpy as np
 
-from fixplan.contact_models import contact_model
-from fixplan.direct_solve import DirectSolver
 from fixplan.errors import FixplanError, InvalidArgumentError
-from fixplan.plan import Plan
-from fixplan.problem import FIXED_FORCE_OBJECTIVES, PASSIVE_ROLES, Load, Problem
-from fixplan.screw import Screw
+from fixplan.planner.contact_models import contact_model
+from fixplan.planner.direct_solve import DirectSolver
+from fixplan.planner.plan import Plan
+from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, PASSIVE_ROLES, Load, Problem
+from fixplan.planner.screw import Screw
 from fixplan.tolerances import (
     EQUILIBRIUM_RTOL,
     FRICTION_SET_RTOL,

@@ -28,14 +28,14 @@ from collections.abc import Callable, Iterable
 import numpy as np
 
 from fixplan import validation
-from fixplan.disk_kernel import AnnulusKernel, DiskKernel
 from fixplan.errors import InvalidArgumentError
-from fixplan.geometry import Pose, triangulate
-from fixplan.inverse import solve
-from fixplan.kernels import PosedKernel, SumKernel, SupportKernel
-from fixplan.point_kernel import PointSetKernel
-from fixplan.polygon_kernel import EdgeSumKernel, polygon_edges
-from fixplan.pressure import (
+from fixplan.surface.disk_kernel import AnnulusKernel, DiskKernel
+from fixplan.surface.geometry import Pose, triangulate
+from fixplan.surface.inverse import solve
+from fixplan.surface.kernels import PosedKernel, SumKernel, SupportKernel
+from fixplan.surface.point_kernel import PointSetKernel
+from fixplan.surface.polygon_kernel import EdgeSumKernel, polygon_edges
+from fixplan.surface.pressure import (
     DiskField,
     FunctionField,
     GridField,
@@ -43,8 +43,8 @@ from fixplan.pressure import (
     PolygonField,
     PressureField,
 )
-from fixplan.rules import gauss_jacobi_unit, triangle_rule
-from fixplan.sphere import circle, fibonacci_sphere
+from fixplan.surface.rules import gauss_jacobi_unit, triangle_rule
+from fixplan.surface.sphere import circle, fibonacci_sphere
 from fixplan.tolerances import CONTAINMENT_RTOL
 
 #: Gauss order per triangle of the far-field rule of polygons (exact to machine precision for
@@ -83,7 +83,7 @@ class LimitSurface:
     def __init__(self, field: PressureField, *, mu: float | Callable, normal_force: float = 1.0):
         if not isinstance(field, PressureField):
             raise InvalidArgumentError(
-                f"field must be a pressure field from fixplan.pressure, got {type(field).__name__}"
+                f"field must be a pressure field from fixplan.surface.pressure, got {type(field).__name__}"
             )
         normal_force = validation.positive_scalar("normal_force", normal_force)
         if callable(mu):
@@ -308,7 +308,7 @@ def _field_kernel(field: PressureField) -> SupportKernel:
     elif isinstance(field, PointsField):  # placed directly: no rounding from a twist transform
         return PointSetKernel(field.pose.apply(field.xy), field.weights, discrete=True)
     elif isinstance(field, FunctionField):
-        from fixplan.function_kernel import FunctionKernel
+        from fixplan.surface.function_kernel import FunctionKernel
 
         local = FunctionKernel(
             regions=_regions(field.shape), pressure=field.function, friction=None
@@ -364,7 +364,7 @@ def _varying_friction_kernel(field: PressureField, mu: Callable) -> SupportKerne
     if isinstance(field, PointsField):
         friction = local_mu(field.xy[:, 0], field.xy[:, 1])
         return PointSetKernel(pose.apply(field.xy), field.weights * friction, discrete=True)
-    from fixplan.function_kernel import FunctionKernel
+    from fixplan.surface.function_kernel import FunctionKernel
 
     pressure = None
     if isinstance(field, DiskField):

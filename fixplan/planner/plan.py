@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fixplan.screw import Screw
+from fixplan.planner.screw import Screw
 
 STATUSES = ("optimal", "infeasible", "unbounded", "inaccurate", "solver-error")
 
@@ -46,7 +46,7 @@ class Plan:
         At the state of impending slip, the fraction of each contact's friction set its wrench
         uses (1 on the limit).
     motions : dict
-        Per load case: the :class:`~fixplan.screw.Screw` in which the body starts to slide when
+        Per load case: the :class:`~fixplan.planner.screw.Screw` in which the body starts to slide when
         the task load exceeds its margin (``None`` when unbounded), from the dual of the
         equilibrium constraints.
     critical_load, critical_contact : str or None

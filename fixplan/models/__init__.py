@@ -19,13 +19,13 @@ model                         torsion     motion  conservative  cvxpy form
 :class:`Exact`                yes         yes     no (±quad.)   one small cone per point
 ============================  ==========  ======  ============  ===========================
 
-Accuracy against the exact surface is measured by :func:`fixplan.compare.compare`.
+Accuracy against the exact surface is measured by :func:`fixplan.models.compare.compare`.
 """
 
-from fixplan.ellipsoid_models import Ellipsoid, FacetedEllipsoid, FittedEllipsoid, fit_ellipsoid
-from fixplan.exact_model import Exact
-from fixplan.model_base import FrictionModel
-from fixplan.polyhedral_models import Cone, PointCone, PointPyramid, Pyramid
+from fixplan.models.base import FrictionModel
+from fixplan.models.ellipsoid import Ellipsoid, FacetedEllipsoid, FittedEllipsoid, fit_ellipsoid
+from fixplan.models.exact import Exact
+from fixplan.models.polyhedral import Cone, PointCone, PointPyramid, Pyramid
 
 #: Every model class, in the order of the table above.
 MODEL_CLASSES = (
