@@ -3,7 +3,9 @@
 Every model is built from an exact :class:`~fixplan.LimitSurface` by
 ``Model.from_limit_surface(ls, ...)`` and offers one interface (:class:`FrictionModel`):
 ``contains``, ``safety_factor``, ``motion`` (where the model has a motion map), ``conservative``
-and ``constraints(load, normal_force)`` for cvxpy. Models are immutable values that store their
+and ``constraints(load, normal_force)`` for cvxpy, and
+``conic_form()``: the same set as cones on affine rows, which the planner stacks over every
+contact and load case. Models are immutable values that store their
 geometry per unit normal force.
 
 ============================  ==========  ======  ============  ===========================
@@ -12,7 +14,7 @@ model                         torsion     motion  conservative  cvxpy form
 :class:`Ellipsoid`            yes         yes     no            one second-order cone
 :class:`FittedEllipsoid`      yes         yes     no            one second-order cone
 :class:`FacetedEllipsoid`     yes         yes     no            cone + 2 inequalities/point
-:class:`Cone`                 yes         no      yes           norm + abs
+:class:`Cone`                 yes         no      yes           two second-order cones
 :class:`Pyramid`              yes         no      if inscribed  ``2k`` linear inequalities
 :class:`PointCone`            no          yes     yes           one second-order cone
 :class:`PointPyramid`         no          no      if inscribed  ``k`` linear inequalities
@@ -22,7 +24,7 @@ model                         torsion     motion  conservative  cvxpy form
 Accuracy against the exact surface is measured by :func:`fixplan.models.compare.compare`.
 """
 
-from fixplan.models.base import FrictionModel
+from fixplan.models.base import ConicForm, FrictionModel
 from fixplan.models.ellipsoid import Ellipsoid, FacetedEllipsoid, FittedEllipsoid, fit_ellipsoid
 from fixplan.models.exact import Exact
 from fixplan.models.polyhedral import Cone, PointCone, PointPyramid, Pyramid
@@ -41,6 +43,7 @@ MODEL_CLASSES = (
 
 __all__ = [
     "MODEL_CLASSES",
+    "ConicForm",
     "Cone",
     "Ellipsoid",
     "Exact",

@@ -28,6 +28,7 @@ twists are still given and returned about the frame origin (DESIGN.md §2). Ther
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
@@ -38,7 +39,7 @@ from fixplan.surface.sphere import circle
 from fixplan.tolerances import CONTAINMENT_RTOL
 
 if TYPE_CHECKING:  # pragma: no cover - typing only; cvxpy is imported when constraints are built
-    import cvxpy as cp
+    pass
 
 _PLANES = {"fx-m": (0, 2), "fy-m": (1, 2), "fx-fy": (0, 1)}
 
@@ -77,8 +78,8 @@ class FrictionModel(ABC):
         )
 
     @abstractmethod
-    def _unit_constraints(self, q: cp.Expression, normal_force: cp.Expression) -> list:
-        """cvxpy constraints for ``g(q) <= normal_force``, convex and DPP."""
+    def _unit_conic(self) -> ConicForm:
+        """``g(q) <= N`` as a :class:`ConicForm` in the normalised coordinates ``q``."""
 
     # -- description -------------------------------------------------------------------------
 
@@ -248,6 +249,28 @@ class FrictionModel(ABC):
 
     # -- convex constraints ------------------------------------------------------------------
 
+    def conic_form(self) -> ConicForm:
+        """The set at normal force ``N`` as cones on affine rows of ``(N, load, aux)``.
+
+        The form stacks: the planner writes every contact and load case of a model type into
+        one cone constraint. ``load`` is ``(ft1, ft2, mn)`` [N, N, N m] about the frame origin
+        (area models) or ``(ft1, ft2)`` [N] (point models).
+        """
+        if self.mu == 0.0:  # frictionless: the load is zero
+            width = self.load_dimension
+            return ConicForm(
+                normal=np.zeros(width), load=np.eye(width), aux=np.zeros((width, 0)),
+                cones=(("zero", width),),
+            )  # fmt: skip
+        unit = self._unit_conic()
+        if self.torsion:
+            cx, cy = self.center
+            about_center = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [cy, -cx, 1.0]])
+        else:
+            about_center = np.eye(2)
+        to_q = about_center / self._units()[:, None]
+        return ConicForm(normal=unit.normal, load=unit.load @ to_q, aux=unit.aux, cones=unit.cones)
+
     def constraints(self, load, normal_force) -> list:
         """cvxpy constraints stating that ``load`` lies in the set at ``normal_force``.
 
@@ -264,7 +287,8 @@ class FrictionModel(ABC):
         Returns
         -------
         list of cvxpy.Constraint
-            Convex and DPP (``problem.is_dcp(dpp=True)`` holds with Parameters).
+            Convex and DPP (``problem.is_dcp(dpp=True)`` holds with Parameters): one per cone
+            kind of :meth:`conic_form`.
         """
         import cvxpy as cp
 
@@ -278,7 +302,6 @@ class FrictionModel(ABC):
         if normal_force.shape == (1,):
             normal_force = cp.reshape(normal_force, (), order="C")
         allowed = ((3,),) if self.torsion else ((2,), (3,))
-        cx, cy = self.center
         if load.shape not in allowed:
             raise InvalidArgumentError(
                 f"load must have shape {' or '.join(str(s) for s in allowed)} for "
@@ -288,10 +311,87 @@ class FrictionModel(ABC):
         if not self.torsion and load.shape == (3,):
             extra.append(load[2] == 0.0)
             load = load[:2]
-        elif cx != 0.0 or cy != 0.0:
-            load = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [cy, -cx, 1.0]]) @ load
-        q = cp.multiply(1.0 / self._units(), load)
-        return self._unit_constraints(q, normal_force) + extra
+        form = self.conic_form()
+        rows = form.normal * normal_force + form.load @ load
+        if form.aux.shape[1]:
+            rows = rows + form.aux @ cp.Variable(form.aux.shape[1], name="aux")
+        return form.cvxpy_constraints(cp.reshape(rows, (form.rows, 1), order="F")) + extra
+
+
+@dataclass(frozen=True, slots=True)
+class ConicForm:
+    r"""A friction set at normal force ``N`` as cones on affine rows, in a form that stacks.
+
+    .. math:: r = a N + B \ell + C z \in \mathcal K_1 \times \dots \times \mathcal K_m
+
+    for the load ``ℓ`` and auxiliary variables ``z`` (e.g. the per-point forces of
+    :class:`~fixplan.models.Exact`). ``cones`` lists ``(kind, size)`` in row order, ``kind``
+    one of ``"zero"`` (rows equal 0), ``"nonneg"`` (rows >= 0) and ``"soc"`` (the first row
+    bounds the norm of the others). Homogeneous in ``(N, ℓ, z)``, so it scales with ``N``.
+
+    Attributes
+    ----------
+    normal : numpy.ndarray
+        ``a`` ``(r,)``.
+    load : numpy.ndarray
+        ``B`` ``(r, d)``.
+    aux : numpy.ndarray
+        ``C`` ``(r, p)``, ``p >= 0``.
+    cones : tuple of (str, int)
+        The cones, in row order; their sizes add up to ``r``.
+    """
+
+    normal: np.ndarray
+    load: np.ndarray
+    aux: np.ndarray
+    cones: tuple[tuple[str, int], ...]
+
+    @property
+    def rows(self) -> int:
+        """Number of rows ``r``."""
+        return len(self.normal)
+
+    def rows_of(self, kind: str, size: int | None = None) -> np.ndarray:
+        """Indices of the rows in cones of ``kind`` (and ``size``), cone after cone."""
+        found, start = [], 0
+        for cone_kind, cone_size in self.cones:
+            if cone_kind == kind and (size is None or cone_size == size):
+                found.append(np.arange(start, start + cone_size))
+            start += cone_size
+        return np.concatenate(found) if found else np.empty(0, dtype=int)
+
+    def cvxpy_constraints(self, rows) -> list:
+        """Constraints on ``rows``, an expression ``(r, n)`` of ``n`` stacked columns: one
+        constraint per cone kind and size over all columns."""
+
+        constraints = []
+        for kind in ("zero", "nonneg"):
+            index = self.rows_of(kind)
+            if index.size:
+                part = rows[index, :]
+                constraints.append(part == 0 if kind == "zero" else part >= 0)
+        for size in sorted({s for kind, s in self.cones if kind == "soc"}):
+            index = self.rows_of("soc", size)
+            constraints.append(soc_columns(rows[index, :], size))
+        return constraints
+
+
+def soc_columns(rows, size: int):
+    """One cvxpy SOC constraint: ``rows`` ``(m * size, n)`` holds ``m`` cones of ``size`` rows
+    in each of its ``n`` columns (the first row of each cone bounds the norm of the rest)."""
+    import cvxpy as cp
+
+    count = rows.shape[0] // size * rows.shape[1]
+    cones = cp.reshape(rows, (size, count), order="F")
+    return cp.SOC(cones[0, :], cones[1:, :], axis=0)
+
+
+def unit_conic(normal, q, aux=None, cones=()) -> ConicForm:
+    """A :class:`ConicForm` in normalised coordinates (what :meth:`_unit_conic` returns)."""
+    normal = np.asarray(normal, dtype=float)
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    aux = np.zeros((len(normal), 0)) if aux is None else np.asarray(aux, dtype=float)
+    return ConicForm(normal=normal, load=q, aux=aux, cones=tuple(cones))
 
 
 def _point_loads(load) -> tuple[np.ndarray, bool]:

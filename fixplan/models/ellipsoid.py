@@ -15,7 +15,7 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import ConvergenceError, InvalidArgumentError
-from fixplan.models.base import FrictionModel, finite_pair, fmt
+from fixplan.models.base import FrictionModel, finite_pair, fmt, unit_conic
 from fixplan.surface.sphere import fibonacci_sphere
 from fixplan.tolerances import FIT_MIN_EIGENVALUE, TILT_ATOL
 
@@ -212,10 +212,8 @@ class Ellipsoid(FrictionModel):
     def _normal(self, q):
         return q @ self.matrix
 
-    def _unit_constraints(self, q, normal_force):
-        import cvxpy as cp
-
-        return [cp.SOC(normal_force, _shear(self.tilt) @ q)]
+    def _unit_conic(self):
+        return _ellipsoid_conic(_shear(self.tilt))
 
     def __repr__(self) -> str:
         return area_repr(self)
@@ -355,10 +353,8 @@ class FittedEllipsoid(FrictionModel):
     def _normal(self, q):
         return q @ self.matrix
 
-    def _unit_constraints(self, q, normal_force):
-        import cvxpy as cp
-
-        return [cp.SOC(normal_force, self._factor @ q)]
+    def _unit_conic(self):
+        return _ellipsoid_conic(self._factor)
 
     def __repr__(self) -> str:
         center = ""
@@ -368,6 +364,11 @@ class FittedEllipsoid(FrictionModel):
             f"FittedEllipsoid(mu={fmt(self.mu)}, rho={fmt(self.rho)} m, {center}"
             f"normal_force={fmt(self.normal_force)} N, fit_error={self.fit_error:.3g})"
         )
+
+
+def _ellipsoid_conic(factor: np.ndarray):
+    """``||F q|| <= N``: one second-order cone of size 4."""
+    return unit_conic([1.0, 0.0, 0.0, 0.0], np.vstack([np.zeros(3), factor]), cones=[("soc", 4)])
 
 
 def fit_ellipsoid(points: np.ndarray) -> tuple[np.ndarray, float]:
@@ -517,14 +518,15 @@ class FacetedEllipsoid(FrictionModel):
         normals[on_facet] = signs[on_facet, None] * self._planes[best[on_facet]]
         return normals
 
-    def _unit_constraints(self, q, normal_force):
-        import cvxpy as cp
-
-        planes = self._planes @ q
-        return [
-            *self.ellipsoid._unit_constraints(q, normal_force),
-            cp.abs(planes) <= normal_force,
-        ]
+    def _unit_conic(self):
+        # The ellipsoid's cone, then |a_i · q| <= N as N - a_i · q >= 0 and N + a_i · q >= 0.
+        cone = self.ellipsoid._unit_conic()
+        count = 2 * len(self._planes)
+        return unit_conic(
+            np.concatenate([cone.normal, np.ones(count)]),
+            np.vstack([cone.load, -self._planes, self._planes]),
+            cones=[*cone.cones, ("nonneg", count)],
+        )
 
     def __repr__(self) -> str:
         return f"FacetedEllipsoid({self.ellipsoid!r}, {len(self.points)} facet pairs)"

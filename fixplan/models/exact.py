@@ -24,7 +24,7 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError
-from fixplan.models.base import FrictionModel, fmt
+from fixplan.models.base import FrictionModel, fmt, unit_conic
 from fixplan.surface.sphere import fibonacci_sphere
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -136,17 +136,24 @@ class Exact(FrictionModel):
         loads, _ = self._surface_loads(q)
         return self._surface.motion(loads) * np.array([1.0, 1.0, self.rho])
 
-    def _unit_constraints(self, q, normal_force):
-        import cvxpy as cp
-
+    def _unit_conic(self):
+        # Auxiliary variables: the point forces z = (f_1, ..., f_n), f_j = (fx_j, fy_j).
+        # Rows: q - resultant(z) / units = 0, then (capacity_j N, f_j) in a cone per point.
         x, y = self.points[:, 0], self.points[:, 1]
         count = len(self.capacity)
-        fx, fy = cp.Variable(count), cp.Variable(count)
-        resultant = cp.hstack([cp.sum(fx), cp.sum(fy), x @ fy - y @ fx])
-        return [
-            cp.SOC(normal_force * self.capacity, cp.vstack([fx, fy]), axis=0),
-            q == cp.multiply(1.0 / self._units(), resultant),
-        ]
+        resultant = np.zeros((3, 2 * count))
+        resultant[0, 0::2] = 1.0
+        resultant[1, 1::2] = 1.0
+        resultant[2, 0::2], resultant[2, 1::2] = -y, x
+        normal = np.zeros(3 + 3 * count)
+        normal[3::3] = self.capacity
+        q = np.zeros((3 + 3 * count, 3))
+        q[:3] = np.eye(3)
+        aux = np.zeros((3 + 3 * count, 2 * count))
+        aux[:3] = -resultant / self._units()[:, None]
+        aux[4::3, 0::2] = np.eye(count)
+        aux[5::3, 1::2] = np.eye(count)
+        return unit_conic(normal, q, aux, cones=[("zero", 3)] + [("soc", 3)] * count)
 
     def __repr__(self) -> str:
         order = "" if self.order is None else f", order={self.order}"

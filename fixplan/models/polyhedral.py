@@ -16,7 +16,7 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError
-from fixplan.models.base import FrictionModel, facet_count, fmt, polygon_normals
+from fixplan.models.base import FrictionModel, facet_count, fmt, polygon_normals, unit_conic
 from fixplan.models.ellipsoid import (
     _shear,
     area_parameters,
@@ -107,14 +107,23 @@ class Cone(FrictionModel):
         fy = q[:, 1] - t[1] * q[:, 2]
         return np.sqrt(fx * fx + fy * fy) + np.abs(q[:, 2])
 
-    def _unit_constraints(self, q, normal_force):
-        import cvxpy as cp
-
-        force = _shear(self.tilt)[:2] @ q
-        return [cp.norm(force, 2) + cp.abs(q[2]) <= normal_force]
+    def _unit_conic(self):
+        # ||F q|| + |q_m| <= N  as  ||F q|| <= N - q_m  and  ||F q|| <= N + q_m.
+        force = _shear(self.tilt)[:2]
+        moment = np.array([[0.0, 0.0, 1.0]])
+        return unit_conic(
+            [1.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+            np.vstack([-moment, force, moment, force]),
+            cones=[("soc", 3), ("soc", 3)],
+        )
 
     def __repr__(self) -> str:
         return area_repr(self, _apex_note(self))
+
+
+def _linear_conic(rows: np.ndarray):
+    """``rows @ q <= N``: linear inequalities."""
+    return unit_conic(np.ones(len(rows)), -rows, cones=[("nonneg", len(rows))])
 
 
 def _apex_note(model) -> str:
@@ -248,8 +257,8 @@ class Pyramid(FrictionModel):
         apothem = _apothem(self.facets, self.inscribed)
         return _polygon_gauge(fx, fy, self.facets, apothem) + np.abs(q[:, 2])
 
-    def _unit_constraints(self, q, normal_force):
-        return [self._rows @ q <= normal_force]
+    def _unit_conic(self):
+        return _linear_conic(self._rows)
 
     def __repr__(self) -> str:
         kind = "inscribed" if self.inscribed else "circumscribed"
@@ -313,10 +322,8 @@ class PointCone(FrictionModel):
     def _normal(self, q):
         return q
 
-    def _unit_constraints(self, q, normal_force):
-        import cvxpy as cp
-
-        return [cp.SOC(normal_force, q)]
+    def _unit_conic(self):
+        return unit_conic([1.0, 0.0, 0.0], np.vstack([np.zeros(2), np.eye(2)]), cones=[("soc", 3)])
 
     def __repr__(self) -> str:
         return f"PointCone(mu={fmt(self.mu)}, normal_force={fmt(self.normal_force)} N)"
@@ -382,8 +389,8 @@ class PointPyramid(FrictionModel):
         apothem = _apothem(self.facets, self.inscribed)
         return _polygon_gauge(q[:, 0], q[:, 1], self.facets, apothem)
 
-    def _unit_constraints(self, q, normal_force):
-        return [self._rows @ q <= normal_force]
+    def _unit_conic(self):
+        return _linear_conic(self._rows)
 
     def __repr__(self) -> str:
         kind = "inscribed" if self.inscribed else "circumscribed"
