@@ -92,7 +92,7 @@ def main() -> None:
     problem = fixture("ellipsoid", "min-total-clamp-force", milling_loads(20, 0))
     planner = Planner(problem)
     planner.solve(analyse=False)
-    compiled = planner._built[problem.objective].problem
+    compiled = planner._runner.stacked(problem.objective).problem
     raw = []
     for _ in range(20):
         raw.append(timed(lambda: compiled.solve(solver=cp.CLARABEL))[1])

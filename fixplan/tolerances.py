@@ -66,3 +66,10 @@ SCREW_PRINT_RTOL = 1e-6
 #: factor is then accurate to about 1e-10 and the motion to about 1e-5 rad; otherwise it raises
 #: ConvergenceError instead of guessing.
 INVERSE_GRADIENT_RTOL = 1e-5
+
+#: Ends of a held interval of task-load multiples below this are 0 (solver noise).
+MULTIPLE_ATOL = 1e-7
+
+#: Passive normal forces that squeeze each other by less than this fraction of the largest
+#: passive normal force of the load case are solver noise, not a squeeze.
+SQUEEZE_RTOL = 1e-6

@@ -13,6 +13,7 @@ from fixplan.planner.contact_models import contact_model
 from fixplan.planner.contact_surface import ContactSetSurface
 from fixplan.planner.planner import Planner, solve
 from fixplan.planner.problem import Body, Contact, Load, Problem, ProblemError
+from fixplan.planner.verify import verify
 
 MU, RADIUS, HALF_GAP = 0.5, 0.01, 0.02
 WEIGHTLESS = Body(mass=0.0, center_of_mass=[0, 0, 0])
@@ -167,9 +168,9 @@ def test_resolving_with_new_loads_reuses_the_compiled_problem():
     problem = pinch("ellipsoid", load=off_axis_load())
     planner = Planner(problem)
     first = planner.solve(analyse=False)
-    compiled = planner._built[problem.objective].problem
+    compiled = planner._runner.stacked(problem.objective).problem
     doubled = planner.solve([off_axis_load(weight=20.0)], analyse=False)
-    assert planner._built[problem.objective].problem is compiled
+    assert planner._runner.stacked(problem.objective).problem is compiled
     assert doubled.objective_value == pytest.approx(2 * first.objective_value, rel=1e-7)
 
 
@@ -233,7 +234,8 @@ def test_verification_flags_a_wrench_outside_its_friction_set():
     normal = np.array([[10.0], [10.0]])
     friction = np.array([[0.0], [5.0], [0.0], [6.0]])  # 6 N > mu * 10 N on the second finger
     wrenches = np.column_stack([off_axis_load(offset=0.0).wrench])
-    _, problems = planner._verify(normal, friction, np.ones(1), wrenches)
+    answer = {"normal": normal, "friction": friction, "scale": np.ones(1)}
+    _, problems = verify(planner.problem, planner.layout, planner.models, answer, wrenches, 0.02)
     assert any("'right' exceeds its friction set" in p for p in problems)
 
 
@@ -382,5 +384,5 @@ def test_given_forces_too_weak_for_the_weight_are_explained_as_such():
     plan = solve(dataclasses.replace(base, body=heavy))
     # Two fingers at 5 N with mu = 0.5 hold 5 N; the part weighs 19.6 N.
     assert plan.status == "infeasible"
-    assert "even without its task load (the weight alone)" in plan.certificate
+    assert "not even without it (with the given active forces and the weight)" in plan.certificate
     assert abs(plan.infeasible_motions["off-axis"].direction @ [0, 0, 1]) == pytest.approx(1.0)

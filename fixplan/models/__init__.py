@@ -43,8 +43,8 @@ MODEL_CLASSES = (
 
 __all__ = [
     "MODEL_CLASSES",
-    "ConicForm",
     "Cone",
+    "ConicForm",
     "Ellipsoid",
     "Exact",
     "FacetedEllipsoid",

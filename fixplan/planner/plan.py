@@ -37,11 +37,17 @@ class Plan:
         for a finger.
     safety_factors : dict
         Per load case: the largest factor by which its task load (not gravity) can be scaled
-        while held with these active forces (``inf`` when no scale breaks the hold).
+        while held with these active forces (``inf`` when no scale breaks the hold): the upper
+        end of ``held_intervals``.
     safety_factor : float
         The smallest of ``safety_factors``.
+    held_intervals : dict
+        Per load case: ``(k_min, k_max)``, the multiples of its task load that are held with
+        these active forces. ``k_min > 0`` when the active forces and the weight alone are not
+        held (fingers or clamps that do not balance each other push the part out unless enough
+        task load pushes back).
     held : dict
-        Per load case: whether the task load itself is held (safety factor >= 1).
+        Per load case: whether the task load itself is held (``k_min <= 1 <= k_max``).
     utilisation : array (contacts, loads)
         At the state of impending slip, the fraction of each contact's friction set its wrench
         uses (1 on the limit).
@@ -56,6 +62,10 @@ class Plan:
         nothing resists it.
     infeasible_motions : dict
         For an infeasible problem: the unresisted motion per load case that cannot be held.
+    squeeze_contacts : tuple of str
+        Passive contacts that can squeeze each other (normal forces that cancel); the planner
+        keeps them from doing so (:mod:`fixplan.planner.squeeze`) and says in ``warnings`` where
+        the rigid solution relied on it.
     residual : float
         Largest relative equilibrium residual found by the verification.
     warnings : tuple of str
@@ -76,6 +86,7 @@ class Plan:
     forces: dict = field(default_factory=dict)
     safety_factors: dict = field(default_factory=dict)
     safety_factor: float | None = None
+    held_intervals: dict = field(default_factory=dict)
     held: dict = field(default_factory=dict)
     utilisation: np.ndarray | None = None
     motions: dict = field(default_factory=dict)
@@ -83,6 +94,7 @@ class Plan:
     critical_contact: str | None = None
     certificate: str | None = None
     infeasible_motions: dict = field(default_factory=dict)
+    squeeze_contacts: tuple[str, ...] = ()
     residual: float | None = None
     warnings: tuple[str, ...] = ()
     solver: str = ""
@@ -113,6 +125,9 @@ class Plan:
             "forces_N": forces,
             "safety_factors": {k: number(v) for k, v in self.safety_factors.items()},
             "safety_factor": None if self.safety_factor is None else number(self.safety_factor),
+            "held_intervals": {
+                k: [number(low), number(high)] for k, (low, high) in self.held_intervals.items()
+            },
             "held": dict(self.held),
             "critical_load": self.critical_load,
             "critical_contact": self.critical_contact,
@@ -136,6 +151,7 @@ class Plan:
                 }
                 for i, contact in enumerate(self.contact_names)
             },
+            "squeeze_contacts": list(self.squeeze_contacts),
             "residual": self.residual,
             "warnings": list(self.warnings),
             "solver": self.solver,

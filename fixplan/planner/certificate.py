@@ -1,0 +1,49 @@
+"""Why a problem cannot be held: the unresisted motions of an infeasible problem, in words.
+
+The dual of the equilibrium constraints of an infeasible problem is a Farkas certificate: per
+load case a twist that the loads drive with positive power while no contact can resist it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fixplan.planner.problem import Problem
+from fixplan.planner.screw import Screw
+
+
+def certificate(
+    problem: Problem, dual: np.ndarray | None, wrenches: np.ndarray, *, fixed_forces: bool,
+    length_scale: float,
+) -> tuple[dict, str]:  # fmt: skip
+    """The unresisted motion of each load case that cannot be held, and the whole in words.
+
+    ``dual`` ``(6, K)`` is the equilibrium dual of the infeasible solve (``None`` when the
+    solver gave none); ``fixed_forces``: the active forces were given (then no multiple of the
+    task load, not even 0, is held).
+    """
+    if dual is None:
+        return {}, "the problem is infeasible (the solver gave no certificate)"
+    size = np.abs(dual).max()
+    gravity = problem.body.weight_wrench
+    motions, lines = {}, []
+    for j, load in enumerate(problem.loads):
+        twist = dual[:, j]
+        if size == 0.0 or np.abs(twist).max() <= 1e-6 * size:
+            continue
+        twist = twist if (wrenches[:, j] + gravity) @ twist >= 0.0 else -twist
+        screw = Screw.from_twist(twist, length_scale)
+        motions[load.name] = screw
+        cause = (
+            " at any multiple of its task load, not even without it (with the given active "
+            "forces and the weight)"
+            if fixed_forces
+            else ""
+        )
+        lines.append(
+            f"load case {load.name!r} cannot be held{cause}; nothing resists the motion in which "
+            f"the body {screw.describe()}"
+        )
+    if not lines:
+        return {}, "the problem is infeasible (the certificate is empty)"
+    return motions, "; ".join(lines)

@@ -1,0 +1,237 @@
+"""Solving the stacked problems: compiled once, re-solved with new loads, block by block.
+
+A :class:`Runner` keeps one compiled problem per objective. The fixed-force objectives solve
+their load cases (independent, since the active forces are given) in blocks of
+``CASES_PER_BLOCK``, so that one compiled problem serves any number of cases; force objectives
+solve all cases at once. Force objectives re-solve straight through Clarabel once the same
+problem has been solved twice (:mod:`fixplan.planner.direct_solve`). A solver failure retries
+once with a fallback solver.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import cvxpy as cp
+import numpy as np
+
+from fixplan.errors import FixplanError, InvalidArgumentError
+from fixplan.planner.direct_solve import DirectSolver
+from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, Problem
+from fixplan.planner.stacking import ContactLayout, Stacked, build, set_given
+
+SOLVERS = ("CLARABEL", "OSQP", "SCS")
+
+#: Above this many scalar variables problems are compiled without DPP: there cvxpy's DPP
+#: compilation costs more than canonicalising afresh at every solve (benchmarks/bench_planner.py).
+DPP_MAX_VARIABLES = 20_000
+
+#: Load cases per compiled problem of the fixed-force objectives (their cases are independent).
+CASES_PER_BLOCK = 64
+
+_FALLBACK = {"CLARABEL": "SCS", "SCS": "CLARABEL", "OSQP": "CLARABEL"}
+_SOLVER_OPTIONS = {
+    "CLARABEL": {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9},
+    "SCS": {"eps": 1e-9, "max_iters": 200_000},
+    "OSQP": {"eps_abs": 1e-8, "eps_rel": 1e-8, "max_iter": 50_000, "polish": True},
+}
+#: Clarabel settings of the direct re-solves: iterative refinement of the KKT solves is off
+#: (a third of the time on the fixture benchmark); every answer is verified in numpy anyway.
+_DIRECT_OPTIONS = {**_SOLVER_OPTIONS["CLARABEL"], "iterative_refinement_enable": False}
+_STATUS = {
+    cp.OPTIMAL: "optimal",
+    cp.OPTIMAL_INACCURATE: "inaccurate",
+    cp.INFEASIBLE: "infeasible",
+    cp.INFEASIBLE_INACCURATE: "infeasible",
+    cp.UNBOUNDED: "unbounded",
+    cp.UNBOUNDED_INACCURATE: "unbounded",
+}
+_SEVERITY = ("optimal", "inaccurate", "unbounded", "infeasible", "solver-error")
+
+
+class Runner:
+    """Compiled stacked problems of one :class:`~fixplan.Problem`, and their solves.
+
+    A result is a dict with ``status``, ``solver``, ``warnings`` and, when solved, ``normal``
+    ``(C, K)``, ``friction`` ``(D, K)``, ``scale`` ``(K,)`` and ``dual`` ``(6, K)`` (the
+    equilibrium multipliers: the twist of impending motion per case).
+    """
+
+    def __init__(self, problem: Problem, layout: ContactLayout, solver: str, *, squeeze: bool):
+        self.problem = problem
+        self.layout = layout
+        self.solver = solver
+        self.squeeze = squeeze
+        self._built: dict[str, Stacked] = {}
+        self._direct: dict[str, DirectSolver | None] = {}
+        self._solves: dict[str, int] = {}
+
+    def block_size(self, objective: str) -> int:
+        """Load cases per compiled problem: the fixed-force objectives split into blocks."""
+        cases = len(self.problem.loads)
+        return min(cases, CASES_PER_BLOCK) if objective in FIXED_FORCE_OBJECTIVES else cases
+
+    def stacked(self, objective: str) -> Stacked:
+        """The compiled problem of ``objective`` (built on first use)."""
+        if objective not in self._built:
+            self._built[objective] = build(
+                self.problem, self.layout, objective, self.block_size(objective),
+                squeeze=self.squeeze,
+            )  # fmt: skip
+        return self._built[objective]
+
+    def run(
+        self,
+        objective: str,
+        wrenches: np.ndarray,
+        given: dict,
+        *,
+        sense: float = 1.0,
+        unloaded: np.ndarray | None = None,
+        progress=None,
+    ) -> dict:
+        """Solve all load cases (task ``wrenches`` ``(6, K)``), block by block.
+
+        ``given`` maps contact index -> its given normal force (float or ``(K,)``) [N];
+        ``sense`` -1 minimises the task-load multiples instead of maximising them;
+        ``unloaded`` ``(passive, K)`` marks passive contacts held without normal force. The
+        last block is padded with copies of its first case.
+        """
+        cases = wrenches.shape[1]
+        block = self.block_size(objective)
+        results = []
+        for start in range(0, cases, block):
+            index = np.arange(start, min(start + block, cases))
+            padded = np.concatenate([index, np.full(block - len(index), index[0])])
+            values = {
+                i: (v if np.ndim(v) == 0 else np.broadcast_to(v, (cases,))[padded])
+                for i, v in given.items()
+            }
+            mask = None if unloaded is None else unloaded[:, padded]
+            result = self._run_block(objective, wrenches[:, padded], values, sense, mask)
+            results.append((result, len(index)))
+            if progress is not None:
+                progress(int(index[-1]) + 1, cases)
+        return _merge(results)
+
+    def _run_block(self, objective, wrenches, given, sense, unloaded) -> dict:
+        stacked = self.stacked(objective)
+        stacked.task.value = wrenches
+        stacked.gravity.value = self.problem.body.weight_wrench
+        set_given(stacked, given, wrenches.shape[1])
+        if stacked.sense is not None:
+            stacked.sense.value = float(sense)
+        if stacked.unloaded is not None:
+            stacked.unloaded.value = (
+                np.zeros(stacked.unloaded.shape) if unloaded is None else unloaded.astype(float)
+            )
+        direct = self._direct_result(objective, stacked)
+        if direct is not None:
+            return direct
+        notes = []
+        solver = self.solver
+        status = _call(stacked.problem, solver)
+        if status == "optimal":
+            self._prepare_direct(objective, stacked)
+        if status in ("solver-error", "inaccurate"):
+            fallback = _FALLBACK[solver]
+            notes.append(f"{solver} returned {status}; retried with {fallback}")
+            solver = fallback
+            status = _call(stacked.problem, solver)
+        result = {"status": status, "solver": solver, "warnings": notes}
+        if status in ("optimal", "inaccurate"):
+            result.update(_values(stacked))
+        if status in ("optimal", "inaccurate", "infeasible"):
+            dual = stacked.balance.dual_value
+            result["dual"] = None if dual is None else np.asarray(dual, dtype=float)
+        return result
+
+    def _direct_result(self, objective: str, stacked: Stacked) -> dict | None:
+        """Solve straight through Clarabel when a direct solver exists for ``objective``."""
+        direct = self._direct.get(objective)
+        values = None if direct is None else direct.solve()
+        if values is None:
+            return None
+        for variable in stacked.problem.variables():
+            variable.save_value(values[variable.id])
+        return {"status": "optimal", "solver": "CLARABEL (direct)", "warnings": [],
+                **_values(stacked)}  # fmt: skip
+
+    def _prepare_direct(self, objective: str, stacked: Stacked) -> None:
+        """Build the direct solver of a force objective after its second cvxpy solve.
+
+        It is checked against that solve's answer (same parameters); one-off problems never
+        pay for it.
+        """
+        if self.solver != "CLARABEL" or objective in FIXED_FORCE_OBJECTIVES:
+            return
+        if objective in self._direct or stacked.problem.status != cp.OPTIMAL:
+            return
+        if stacked.problem.size_metrics.num_scalar_variables > DPP_MAX_VARIABLES:
+            return
+        self._solves[objective] = self._solves.get(objective, 0) + 1
+        if self._solves[objective] >= 2:
+            self._direct[objective] = DirectSolver.create(stacked.problem, _DIRECT_OPTIONS)
+
+
+def _values(stacked: Stacked) -> dict:
+    return {
+        "normal": np.asarray(stacked.normal.value, dtype=float),
+        "friction": np.asarray(stacked.friction.value, dtype=float),
+        "scale": np.asarray(stacked.scale.value, dtype=float).ravel(),
+    }
+
+
+def _call(problem: cp.Problem, solver: str) -> str:
+    # cvxpy's DPP compilation grows faster than the problem: past DPP_MAX_VARIABLES
+    # canonicalising afresh is quicker than compiling the parameter map.
+    large = problem.size_metrics.num_scalar_variables > DPP_MAX_VARIABLES
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            problem.solve(solver=solver, ignore_dpp=large, **_SOLVER_OPTIONS[solver])
+    except cp.error.SolverError as exc:
+        if solver == "OSQP" and "QP" in str(exc):
+            raise InvalidArgumentError(
+                "solver OSQP handles only LP/QP problems: use pyramid models "
+                "('pyramid', 'point-pyramid') or the default solver CLARABEL"
+            ) from exc
+        return "solver-error"
+    except cp.error.DCPError as exc:  # pragma: no cover - a model broke its contract
+        raise FixplanError(f"internal error: {exc}") from exc
+    return _STATUS.get(problem.status, "solver-error")
+
+
+def _merge(results: list[tuple[dict, int]]) -> dict:
+    """One result from the results of consecutive blocks (``(result, cases used)`` pairs)."""
+    if len(results) == 1:
+        result, used = results[0]
+        return _trim(result, used)
+    status = max((r["status"] for r, _ in results), key=_SEVERITY.index)
+    merged = {
+        "status": status,
+        "solver": ", ".join(dict.fromkeys(r["solver"] for r, _ in results)),
+        "warnings": [note for r, _ in results for note in r["warnings"]],
+    }
+    trimmed = [_trim(r, used) for r, used in results]
+    for key in ("normal", "friction", "scale", "dual"):
+        parts = [r.get(key) for r in trimmed]
+        if status == "infeasible" and key == "dual":
+            parts = [
+                p if r["status"] == "infeasible" else np.zeros((6, used))
+                for p, r, (_, used) in zip(parts, trimmed, results, strict=True)
+            ]
+        if all(p is not None for p in parts):
+            merged[key] = np.concatenate(parts, axis=-1)
+    return merged
+
+
+def _trim(result: dict, used: int) -> dict:
+    """Drop the padding columns of a block's result."""
+    trimmed = dict(result)
+    for key in ("normal", "friction", "dual"):
+        if trimmed.get(key) is not None:
+            trimmed[key] = trimmed[key][:, :used]
+    if "scale" in trimmed:
+        trimmed["scale"] = trimmed["scale"][:used]
+    return trimmed

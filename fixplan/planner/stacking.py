@@ -1,0 +1,283 @@
+r"""The planning problem as one stacked convex program.
+
+Every (contact, load case) pair is a column. Contact ``i`` in case ``j`` has a normal force
+``n_ij``, a friction load ``ℓ_ij`` and, for some models, auxiliary variables ``z_ij``; the
+friction set of its model is a :class:`~fixplan.models.ConicForm`
+``a_i n_ij + B_i ℓ_ij + C_i z_ij ∈ K_i``. The rows of all contacts are stacked into sparse
+matrices once, so that the whole problem has one equilibrium constraint block
+
+.. math:: G_n N + G_f F + W \operatorname{diag}(s) + W_g 1^T = 0
+
+and one constraint per cone kind (zero, nonnegative, second-order cones of each size) over all
+columns, whatever the numbers of contacts and load cases. cvxpy compiles such a problem in
+time and memory that grow linearly with contacts × cases; one constraint per pair grows far
+faster (20 contacts × 100 cases ran out of memory).
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import cvxpy as cp
+import numpy as np
+import scipy.sparse as sp
+
+from fixplan.models.base import ConicForm, FrictionModel, soc_columns
+from fixplan.planner.objectives import objective_expression
+from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, PASSIVE_ROLES, Problem
+from fixplan.tolerances import MAX_SAFETY_FACTOR
+
+#: Suffix of the second stage of a force objective (clamps given, fingers minimised per case).
+REFINE = "|refine"
+
+
+@dataclass(frozen=True, slots=True)
+class ContactLayout:
+    """Where each contact's normal force, friction load and auxiliary variables sit.
+
+    Attributes
+    ----------
+    normal_map : numpy.ndarray
+        ``(6, C)``: body wrench per unit normal force of each contact.
+    friction_map : numpy.ndarray
+        ``(6, D)``: body wrench per unit friction load component, contact after contact.
+    slices : tuple of slice
+        Rows of each contact's friction load in the stacked friction variable.
+    cones : dict
+        ``(kind, size) -> (normal, friction, aux)`` sparse row blocks of the friction sets
+        (``kind`` ``"zero"``, ``"nonneg"`` or ``"soc"``; ``size`` 0 for the first two).
+    aux_size : int
+        Auxiliary variables per load case.
+    """
+
+    normal_map: np.ndarray
+    friction_map: np.ndarray
+    slices: tuple[slice, ...]
+    cones: dict
+    aux_size: int
+
+    @classmethod
+    def of(cls, problem: Problem, models: list[FrictionModel]) -> ContactLayout:
+        """The layout of ``problem``'s contacts with their friction ``models``."""
+        dims = [model.load_dimension for model in models]
+        bases = [contact.wrench_basis() for contact in problem.contacts]
+        starts = np.concatenate([[0], np.cumsum(dims)])
+        slices = tuple(slice(int(a), int(b)) for a, b in itertools.pairwise(starts))
+        forms = [model.conic_form() for model in models]
+        aux_starts = np.concatenate([[0], np.cumsum([f.aux.shape[1] for f in forms])])
+        return cls(
+            normal_map=np.column_stack([basis[:, 0] for basis in bases]),
+            friction_map=np.hstack(
+                [basis[:, 1 : 1 + d] for basis, d in zip(bases, dims, strict=True)]
+            ),
+            slices=slices,
+            cones=_stack_cones(forms, starts, aux_starts),
+            aux_size=int(aux_starts[-1]),
+        )
+
+
+def _stack_cones(forms: list[ConicForm], starts, aux_starts) -> dict:
+    """Row blocks of every contact's friction set, grouped by cone kind and size."""
+    contacts, width, aux_width = len(forms), int(starts[-1]), int(aux_starts[-1])
+    groups = {("zero", 0), ("nonneg", 0)}
+    groups |= {("soc", size) for form in forms for kind, size in form.cones if kind == "soc"}
+    stacked = {}
+    for kind, size in sorted(groups):
+        normal, friction, aux = [], [], []
+        for i, form in enumerate(forms):
+            rows = form.rows_of(kind, size or None)
+            if rows.size == 0:
+                continue
+            count = rows.size
+            normal.append(sp.coo_array((form.normal[rows], (np.arange(count), np.full(count, i))),
+                                       shape=(count, contacts)))  # fmt: skip
+            block = np.zeros((count, width))
+            block[:, starts[i] : starts[i + 1]] = form.load[rows]
+            friction.append(sp.coo_array(block))
+            block = np.zeros((count, aux_width))
+            block[:, aux_starts[i] : aux_starts[i + 1]] = form.aux[rows]
+            aux.append(sp.coo_array(block))
+        if normal:
+            stacked[kind, size] = tuple(
+                sp.vstack(part, format="csr") for part in (normal, friction, aux)
+            )
+    return stacked
+
+
+@dataclass(frozen=True, slots=True)
+class Stacked:
+    """A compiled cvxpy problem of one objective over a block of load cases, and its handles.
+
+    Attributes
+    ----------
+    problem : cvxpy.Problem
+    task, gravity : cvxpy.Parameter
+        Task wrenches ``(6, K)`` and the gravity wrench ``(6,)``.
+    given : dict
+        Contact index -> ``("finger" | "clamp", row)``: where its given normal force sits in
+        ``given_fingers`` ``(m, K)`` or ``given_clamps`` ``(m,)`` (see :func:`set_given`).
+    given_fingers, given_clamps : cvxpy.Parameter or None
+    sense : cvxpy.Parameter or None
+        +1 to maximise the task-load multiples, -1 to minimise them (fixed-force objectives).
+    unloaded : cvxpy.Parameter or None
+        ``(passive contacts, K)``: 1 where a passive contact is held without normal force.
+    normal : cvxpy.Expression
+        ``(C, K)`` normal forces.
+    friction : cvxpy.Variable
+        ``(D, K)`` friction loads.
+    scale : cvxpy.Expression
+        ``(K,)`` task-load multiples (1 for the force objectives).
+    balance : cvxpy.Constraint
+        The equilibrium block; its dual is the twist of impending motion per case.
+    decided : numpy.ndarray
+        ``(C,)`` bool: the contact's normal force is a decision variable (passive, or an active
+        contact whose force is free in this objective).
+    """
+
+    problem: cp.Problem
+    task: cp.Parameter
+    gravity: cp.Parameter
+    given: dict
+    given_fingers: cp.Parameter | None
+    given_clamps: cp.Parameter | None
+    sense: cp.Parameter | None
+    unloaded: cp.Parameter | None
+    normal: cp.Expression
+    friction: cp.Variable
+    scale: cp.Expression
+    balance: cp.Constraint
+    decided: np.ndarray
+
+
+def build(
+    problem: Problem, layout: ContactLayout, objective: str, cases: int, *, squeeze: bool
+) -> Stacked:
+    """The stacked problem of ``objective`` (``objective + REFINE``: its second stage, with the
+    clamp forces given) over ``cases`` load cases.
+
+    ``squeeze`` adds the ``unloaded`` Parameter (see :mod:`fixplan.planner.squeeze`).
+    """
+    contacts = problem.contacts
+    scaling = objective in FIXED_FORCE_OBJECTIVES
+    refine = objective.endswith(REFINE)
+    count = len(contacts)
+
+    def given(contact) -> bool:
+        if contact.role in PASSIVE_ROLES:
+            return False
+        return scaling or contact.force is not None or (refine and contact.role == "clamp")
+
+    groups = {"passive": [], "finger": [], "clamp": [], "given-finger": [], "given-clamp": []}
+    for i, contact in enumerate(contacts):
+        role = "passive" if contact.role in PASSIVE_ROLES else contact.role
+        groups[f"given-{role}" if given(contact) else role].append(i)
+    ones = np.ones((1, cases))
+    pieces = {
+        "passive": cp.Variable((len(groups["passive"]), cases), nonneg=True, name="passive"),
+        "finger": cp.Variable((len(groups["finger"]), cases), nonneg=True, name="fingers"),
+        "clamp": cp.Variable(len(groups["clamp"]), nonneg=True, name="clamps"),
+        "given-finger": cp.Parameter((len(groups["given-finger"]), cases), nonneg=True),
+        "given-clamp": cp.Parameter(len(groups["given-clamp"]), nonneg=True),
+    }
+    normal = 0
+    for key, index in groups.items():
+        if not index:
+            continue
+        piece = pieces[key]
+        if piece.ndim == 1:
+            piece = cp.reshape(piece, (len(index), 1), order="F") @ ones
+        select = sp.csr_array((np.ones(len(index)), (index, np.arange(len(index)))),
+                              shape=(count, len(index)))  # fmt: skip
+        normal = normal + select @ piece
+    friction = cp.Variable((layout.friction_map.shape[1], cases), name="friction")
+    aux = cp.Variable((layout.aux_size, cases), name="aux") if layout.aux_size else None
+
+    constraints = []
+    task = cp.Parameter((6, cases), name="task_wrenches")
+    gravity = cp.Parameter(6, name="gravity_wrench")
+    sense = None
+    if scaling:
+        scale = cp.Variable(cases, name="scale")
+        constraints += [scale >= 0.0, scale <= MAX_SAFETY_FACTOR]
+        task_term = task @ cp.diag(scale)
+        sense = cp.Parameter(name="sense", value=1.0)
+    else:
+        scale = cp.Constant(np.ones(cases))
+        task_term = task
+    gravity_term = cp.reshape(gravity, (6, 1), order="F") @ ones
+    balance = (
+        layout.normal_map @ normal + layout.friction_map @ friction + task_term + gravity_term == 0
+    )
+    constraints.append(balance)
+    for (kind, size), (on_normal, on_friction, on_aux) in layout.cones.items():
+        rows = on_normal @ normal + on_friction @ friction
+        if aux is not None and on_aux.nnz:
+            rows = rows + on_aux @ aux
+        if kind == "zero":
+            constraints.append(rows == 0)
+        elif kind == "nonneg":
+            constraints.append(rows >= 0)
+        else:
+            constraints.append(soc_columns(rows, size))
+    for key in ("finger", "clamp"):
+        bounded = [(k, contacts[i].max_force) for k, i in enumerate(groups[key])
+                   if contacts[i].max_force is not None]  # fmt: skip
+        if bounded:
+            rows, limits = zip(*bounded, strict=True)
+            limits = np.asarray(limits)
+            variable = pieces[key][list(rows)]
+            constraints.append(variable <= (limits[:, None] if key == "finger" else limits))
+    unloaded = None
+    if squeeze and groups["passive"]:
+        unloaded = cp.Parameter((len(groups["passive"]), cases), nonneg=True, name="unloaded")
+        unloaded.value = np.zeros(unloaded.shape)
+        constraints.append(cp.multiply(unloaded, pieces["passive"]) == 0)
+
+    free_index = groups["finger"] + groups["clamp"]
+    goal = objective_expression(
+        objective.removesuffix(REFINE),
+        scale=scale,
+        sense=sense,
+        clamps=pieces["clamp"] if groups["clamp"] else None,
+        fingers=pieces["finger"] if groups["finger"] else None,
+        free_forces=normal[sorted(free_index), :] if free_index else None,
+    )
+    compiled = cp.Problem(goal, constraints)
+    decided = np.ones(count, dtype=bool)
+    decided[groups["given-finger"] + groups["given-clamp"]] = False
+    return Stacked(
+        problem=compiled,
+        task=task,
+        gravity=gravity,
+        given={
+            i: (key.removeprefix("given-"), row)
+            for key in ("given-finger", "given-clamp")
+            for row, i in enumerate(groups[key])
+        },
+        given_fingers=pieces["given-finger"] if groups["given-finger"] else None,
+        given_clamps=pieces["given-clamp"] if groups["given-clamp"] else None,
+        sense=sense,
+        unloaded=unloaded,
+        normal=normal,
+        friction=friction,
+        scale=scale,
+        balance=balance,
+        decided=decided,
+    )
+
+
+def set_given(stacked: Stacked, values: dict, cases: int) -> None:
+    """Set the given normal forces [N]: ``values`` maps contact index -> float or ``(cases,)``."""
+    fingers, clamps = stacked.given_fingers, stacked.given_clamps
+    finger_values = None if fingers is None else np.zeros(fingers.shape)
+    clamp_values = None if clamps is None else np.zeros(clamps.shape)
+    for i, (kind, row) in stacked.given.items():
+        if kind == "finger":
+            finger_values[row] = np.broadcast_to(values[i], (cases,))
+        else:
+            clamp_values[row] = float(np.ravel(values[i])[0])
+    if fingers is not None:
+        fingers.value = finger_values
+    if clamps is not None:
+        clamps.value = clamp_values

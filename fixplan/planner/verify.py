@@ -1,0 +1,84 @@
+"""Every answer checked in numpy before it is reported: equilibrium and friction sets."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fixplan.models.base import FrictionModel
+from fixplan.planner.problem import Problem
+from fixplan.planner.stacking import ContactLayout
+from fixplan.tolerances import EQUILIBRIUM_RTOL, FRICTION_SET_RTOL
+
+
+def verify(
+    problem: Problem,
+    layout: ContactLayout,
+    models: list[FrictionModel],
+    answer: dict,
+    wrenches: np.ndarray,
+    length_scale: float,
+) -> tuple[float, list[str]]:
+    """The largest relative equilibrium residual of ``answer`` and what failed, in words.
+
+    ``answer`` holds ``normal`` ``(C, K)`` [N], ``friction`` ``(D, K)`` and ``scale`` ``(K,)``;
+    ``wrenches`` ``(6, K)`` are the task wrenches. Forces are compared with the forces of each
+    case's wrench terms and moments with their moments (at least force × ``length_scale``).
+    """
+    normal, friction, scale = answer["normal"], answer["friction"], answer["scale"]
+    problems = []
+    gravity = problem.body.weight_wrench[:, None]
+    normal_part = layout.normal_map @ normal
+    friction_part = layout.friction_map @ friction
+    task_part = wrenches * scale[None, :]
+    residual = normal_part + friction_part + task_part + gravity
+    magnitude = np.abs(normal_part) + np.abs(friction_part) + np.abs(task_part) + np.abs(gravity)
+    force_size = np.maximum(magnitude[:3].max(axis=0), 1e-12)
+    moment_size = np.maximum(magnitude[3:].max(axis=0), force_size * length_scale)
+    relative = 0.0
+    for rows, unit, size in ((slice(0, 3), "N", force_size), (slice(3, 6), "N m", moment_size)):
+        ratio = np.abs(residual[rows]).max(axis=0) / size
+        relative = max(relative, float(ratio.max()))
+        worst = int(np.argmax(ratio))
+        if ratio[worst] > EQUILIBRIUM_RTOL:
+            problems.append(
+                f"equilibrium residual of load case {worst + 1}: "
+                f"{ratio[worst] * size[worst]:.3g} {unit}, over {EQUILIBRIUM_RTOL:g} of the "
+                f"wrenches involved ({size[worst]:.3g} {unit})"
+            )
+    scale_force = max(float(np.abs(normal).max()), 1e-12)
+    for i, (contact, model) in enumerate(zip(problem.contacts, models, strict=True)):
+        fn = normal[i]
+        if np.any(fn < -FRICTION_SET_RTOL * scale_force):
+            problems.append(f"contact {contact.name!r} pulls: normal force {fn.min():.3g} N")
+        load = friction[layout.slices[i]].T
+        noise = FRICTION_SET_RTOL * scale_force
+        pressed = fn > noise
+        loose = np.abs(load).max(axis=1) > noise
+        if np.any(loose & ~pressed):
+            problems.append(f"contact {contact.name!r} carries friction without normal force")
+        use = friction_use(model, load, fn, noise=noise)
+        if np.any(pressed & (use > 1.0 + FRICTION_SET_RTOL)):
+            problems.append(
+                f"contact {contact.name!r} exceeds its friction set by "
+                f"{use[pressed].max() - 1.0:.3g}"
+            )
+    return relative, problems
+
+
+def friction_use(
+    model: FrictionModel, load: np.ndarray, normal_force: np.ndarray, *, noise: float
+) -> np.ndarray:
+    """Fraction of its friction set that each load ``(K, d)`` uses at ``normal_force`` ``(K,)``.
+
+    1 on the limit; 0 for loads and normal forces within ``noise`` [N] of 0 (solver noise);
+    ``inf`` for a load on a contact without normal force or without friction.
+    """
+    use = np.zeros(len(load))
+    carries = np.abs(load).max(axis=1) > noise
+    pressed = carries & (normal_force > noise)
+    use[carries & ~pressed] = np.inf
+    if np.any(pressed):
+        safety = np.atleast_1d(model.safety_factor(load[pressed] / normal_force[pressed, None]))
+        with np.errstate(divide="ignore"):
+            use[pressed] = 1.0 / safety
+    return use
