@@ -34,11 +34,11 @@ def positive_scalar(name: str, value: object) -> float:
 
 
 def nonnegative_scalar(name: str, value: object) -> float:
-    """Return ``value`` as a finite float >= 0."""
+    """Return ``value`` as a finite float >= 0 (``-0.0`` becomes ``0.0``)."""
     number = finite_scalar(name, value)
     if number < 0.0:
         raise InvalidArgumentError(f"{name} must be >= 0, got {number!r}")
-    return number
+    return number + 0.0
 
 
 def finite_array(name: str, value: object, *, shape: tuple[int | None, ...]) -> np.ndarray:

@@ -519,7 +519,7 @@ def _api_inputs():
         "unknown plane": (lambda: surface.curve("xy"), ["plane", "fy-m"]),
         "no curve points": (lambda: surface.curve(n=0), ["n", "positive"]),
         "fractional sample size": (lambda: surface.sample(2.5), ["n", "positive"]),
-        "negative mu": (lambda: LimitSurface(field, mu=-0.5), ["mu", "> 0"]),
+        "negative mu": (lambda: LimitSurface(field, mu=-0.5), ["mu", ">= 0"]),
         "NaN mu": (lambda: LimitSurface(field, mu=math.nan), ["mu", "finite"]),
         "zero normal force": (
             lambda: LimitSurface(field, mu=0.5, normal_force=0.0),

@@ -437,8 +437,8 @@ def test_pyramid_inequalities_hold_off_the_centre_of_pressure(skewed):
 
 
 def test_models_refuse_bad_parameters_naming_them(disk):
-    with pytest.raises(InvalidArgumentError, match="mu must be > 0"):
-        Ellipsoid(mu=0.0, rho=0.01)
+    with pytest.raises(InvalidArgumentError, match="mu must be >= 0"):
+        Ellipsoid(mu=-0.1, rho=0.01)
     with pytest.raises(InvalidArgumentError, match="rho must be > 0"):
         Cone(mu=1.0, rho=-0.01)
     with pytest.raises(InvalidArgumentError, match="normal_force must be > 0"):

@@ -301,3 +301,65 @@ def test_inner_pyramid_lies_inside_cone_inside_outer_pyramid(field, facets):
     s_point = [p.safety_factor(forces) for p in points]
     assert np.all(s_point[0] <= s_point[1] * (1 + 1e-12))
     assert np.all(s_point[1] <= s_point[2] * (1 + 1e-12))
+
+
+# -- frictionless contacts (mu = 0) ---------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("name", "field"), CASES)
+def test_a_frictionless_model_holds_the_zero_load_and_nothing_else(name, field):
+    m = model(name, field, mu=0.0)
+    loads = loads_for(model(name, field), 16, seed=9)
+    assert m.frictionless and m.mu == 0.0
+    assert m.max_force == 0.0 and m.max_moment == 0.0
+    assert np.all(m.safety_factor(loads) == 0.0) and not np.any(m.contains(loads))
+    assert m.safety_factor(np.zeros(3)) == np.inf and m.contains(np.zeros(3))
+    assert m.conservative == model(name, field).conservative
+    plane = "fx-m" if m.torsion else "fx-fy"
+    assert np.all(m.curve(plane, 12) == 0.0)
+    assert np.all(m.curve(plane, 12, normalized=True) == 0.0)
+
+
+@pytest.mark.parametrize(("name", "field"), CASES)
+def test_a_frictionless_model_has_the_shape_of_the_same_model_with_mu_one(name, field):
+    frictionless, unit = model(name, field, mu=0.0), model(name, field, mu=1.0)
+    assert frictionless.rho == pytest.approx(unit.rho, rel=1e-12)
+    assert frictionless.center == pytest.approx(unit.center, abs=1e-15)
+    assert frictionless.friction_shape.mu == pytest.approx(unit.mu, rel=1e-12)
+    loads = loads_for(unit, 16, seed=10)
+    np.testing.assert_allclose(
+        frictionless.friction_shape.safety_factor(loads), unit.safety_factor(loads), rtol=1e-9
+    )
+
+
+@pytest.mark.parametrize(("name", "field"), CASES)
+def test_the_motion_of_a_frictionless_model_is_the_limit_of_vanishing_friction(name, field):
+    frictionless = model(name, field, mu=0.0)
+    loads = loads_for(model(name, field), 16, seed=11)
+    if not frictionless.has_motion:
+        with pytest.raises(ModelError, match="no motion map"):
+            frictionless.motion(loads[0])
+        return
+    twists = frictionless.motion(loads)
+    for mu in (1.0, 1e-3):
+        np.testing.assert_allclose(twists, model(name, field, mu=mu).motion(loads), atol=1e-9)
+    assert np.all(np.isnan(frictionless.motion(np.zeros(3))))
+
+
+@pytest.mark.parametrize(("name", "field"), CASES)
+def test_the_constraints_of_a_frictionless_model_force_the_load_to_zero(name, field):
+    m = model(name, field, mu=0.0)
+    load = cp.Variable(m.load_dimension)
+    target = cp.Parameter(m.load_dimension)
+    force = cp.Parameter(nonneg=True)
+    nearest = cp.Problem(cp.Minimize(cp.sum_squares(load - target)), m.constraints(load, force))
+    assert nearest.is_dcp(dpp=True)
+    target.value, force.value = np.array([3.0, -2.0, 0.05])[: m.load_dimension], 10.0
+    nearest.solve(solver=cp.CLARABEL)
+    assert nearest.status == cp.OPTIMAL
+    np.testing.assert_allclose(load.value, 0.0, atol=1e-9)
+    # Homogeneous in the normal force: no normal force, however large, holds a nonzero load.
+    fn = cp.Variable(nonneg=True)
+    least = cp.Problem(cp.Minimize(fn), [*m.constraints(load, fn), load == target])
+    least.solve(solver=cp.CLARABEL)
+    assert least.status == cp.INFEASIBLE

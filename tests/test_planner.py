@@ -262,7 +262,7 @@ def test_three_point_contact_set_surface_equals_the_planar_limit_surface_of_the_
     ("change", "message"),
     [
         ({"normal": [0, 0, 0]}, "normal must be a nonzero direction"),
-        ({"mu": -0.1}, "mu must be > 0"),
+        ({"mu": -0.1}, "mu must be >= 0"),
         ({"role": "jaw"}, "role must be one of"),
         ({"model": "brick"}, "model must be one of"),
         ({"role": "locator", "force": 10.0}, "force is only for active contacts"),

@@ -270,11 +270,14 @@ def test_an_unknown_model_override_is_an_invalid_argument(tmp_path):
         pytest.param(
             [("mu = 0.25", "mu = -0.25")],
             "contacts[0].mu",
-            "expected a number > 0, got -0.25",
+            "expected a number >= 0, got -0.25",
             id="negative-mu",
         ),
         pytest.param(
-            [("mu = 0.3", "mu = 0")], "defaults.mu", "expected a number > 0", id="zero-default-mu"
+            [("mu = 0.3", "mu = -0.1")],
+            "defaults.mu",
+            "expected a number >= 0",
+            id="negative-default-mu",
         ),
         pytest.param(
             [("max_force = 2000.0", "max_force = -1.0")],
@@ -382,7 +385,7 @@ def test_an_unknown_model_override_is_an_invalid_argument(tmp_path):
         pytest.param(
             [("mu = 0.3\n", "")],
             "contacts[1].mu",
-            "missing required key; expected a number > 0 here or in [defaults]",
+            "missing required key; expected a number >= 0 here or in [defaults]",
             id="mu-nowhere",
         ),
         pytest.param(

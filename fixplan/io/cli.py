@@ -316,6 +316,7 @@ def _run_surface(args: argparse.Namespace) -> int:
         "max_force_N": surface.max_force,
         "max_moment_Nm": surface.max_moment,
         "characteristic_length_m": surface.characteristic_length,
+        "frictionless": surface.frictionless,
         "models": {
             name: {
                 "max_overestimate": acc.max_overestimate,
@@ -334,6 +335,9 @@ def _run_surface(args: argparse.Namespace) -> int:
     print(f"  max friction force     {surface.max_force:12.6g} N")
     print(f"  max friction moment    {surface.max_moment:12.6g} N m")
     print(f"  characteristic length  {surface.characteristic_length:12.6g} m")
+    if surface.frictionless:
+        print("  frictionless: the limit surface is the load 0; the errors below are those of")
+        print("  the shapes (mu = 1), the same at any mu > 0")
     print("model errors against the exact surface (radial, over 1000 load directions;")
     print("  over = model holds more than the contact: unsafe)")
     print(f"  {'model':24s} {'max over':>9s} {'max under':>10s} {'unsafe':>7s} {'motion':>9s}")

@@ -286,6 +286,11 @@ def _section_data(
             f"contact {contact.name!r} has a point model ({type(model).__name__}): its sections "
             "are drawn for area contacts only"
         )
+    if model.frictionless:
+        raise InvalidArgumentError(
+            f"contact {contact.name!r} is frictionless (mu = 0): its friction set is the single "
+            "load 0, which has no sections to draw"
+        )
     load = validation.finite_array("load", load, shape=(3,))
     force = validation.positive_scalar("normal_force", normal_force)
     units = force * np.array([model.mu, model.mu, model.mu * model.rho])
@@ -334,7 +339,8 @@ def contact_section_figure(
     contact : Contact
         The contact (its name labels the figure).
     model : FrictionModel
-        Its friction model at unit normal force (``Planner.models[i]``); an area model.
+        Its friction model at unit normal force (``Planner.models[i]``); an area model with
+        friction (a frictionless model's set is a point).
     load : array_like (3,)
         Friction load ``(ft1, ft2, mn)`` [N, N, N m] the contact carries, in its frame
         (``plan.contact_wrenches[i, j, 1:]``).
@@ -564,9 +570,14 @@ class _SurfaceSections:
     exact: tuple[np.ndarray, ...]  # (n, 2) normalised sections of the exact surface
     models: dict  # name -> tuple of (n, 2) sections (area models only)
     title: str
+    point: bool  # the surface is the single load 0 (frictionless)
 
 
 def _surface_data(surface: LimitSurface, models: dict) -> _SurfaceSections:
+    if surface.frictionless:
+        origin = np.zeros((1, 2))
+        title = "frictionless contact (mu = 0): its limit surface and every model are the load 0"
+        return _SurfaceSections(exact=(origin,) * 3, models={}, title=title, point=True)
     exact = tuple(
         surface.curve(plane, SECTION_POINTS, normalized=True)[:, [a, b]]
         for plane, a, b in _SECTION_PLANES
@@ -585,7 +596,7 @@ def _surface_data(surface: LimitSurface, models: dict) -> _SurfaceSections:
         f"limit surface: max force {_fmt(surface.max_force)} N, max moment "
         f"{_fmt(surface.max_moment)} N m"
     )
-    return _SurfaceSections(exact=exact, models=sections, title=title)
+    return _SurfaceSections(exact=exact, models=sections, title=title, point=False)
 
 
 def surface_figure(surface: LimitSurface, models: dict, *, axes=None) -> Figure:
@@ -593,7 +604,8 @@ def surface_figure(surface: LimitSurface, models: dict, *, axes=None) -> Figure:
 
     The (fx, m), (fy, m) and (fx, fy) sections in the paper's normalised coordinates (force
     over ``max_force``, moment over ``max_moment`` of the exact surface), as in its Figs. 3
-    and 5. ``models`` maps a label to a friction model built from ``surface``.
+    and 5. ``models`` maps a label to a friction model built from ``surface``. A frictionless
+    surface is drawn as the point 0, which is also every model of it.
     """
     data = _surface_data(surface, models)
     if axes is None:
@@ -603,9 +615,14 @@ def surface_figure(surface: LimitSurface, models: dict, *, axes=None) -> Figure:
         fig = axes[0].figure
     labels = (r"$f_x/f_{max}$", r"$f_y/f_{max}$", r"$m/m_{max}$")
     for index, (ax, (_, a, b)) in enumerate(zip(axes, _SECTION_PLANES, strict=True)):
-        ax.plot(*_closed(data.exact[index]).T, color="black", linewidth=2.0, label="exact")
+        ax.plot(*_closed(data.exact[index]).T, color="black", linewidth=2.0,
+                label="exact: the load 0" if data.point else "exact",
+                marker="o" if data.point else None)  # fmt: skip
         for name, curves in data.models.items():
             ax.plot(*_closed(curves[index]).T, linewidth=1.0, label=name)
+        if data.point:
+            ax.set_xlim(-1.0, 1.0)
+            ax.set_ylim(-1.0, 1.0)
         ax.set_xlabel(labels[a])
         ax.set_ylabel(labels[b])
         ax.set_aspect("equal")

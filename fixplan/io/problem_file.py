@@ -25,7 +25,8 @@ SI throughout. The schema::
     role = "locator"                      # locator | support | clamp | finger
     position = [-0.05, 0.0, 0.02]         # [m]
     normal = [1.0, 0.0, 0.0]              # into the body, a unit vector
-    mu = 0.25                             # > 0; required unless [defaults] gives it
+    mu = 0.25                             # >= 0 (0: frictionless); required unless
+                                          # [defaults] gives it
     model = "exact"                       # exact | ellipsoid | cone | pyramid | point-cone
                                           # | point-pyramid; required unless [defaults] gives it
     facets = 8                            # pyramid models only, >= 3
@@ -580,7 +581,7 @@ class _Reader:
         if table is None:
             return _Defaults()
         table.check_keys(_DEFAULT_KEYS)
-        kinds = {"mu": _POSITIVE, "model": _MODEL, "facets": _FACETS, "inscribed": _BOOLEAN}
+        kinds = {"mu": _NONNEGATIVE, "model": _MODEL, "facets": _FACETS, "inscribed": _BOOLEAN}
         values = {key: table.get(key, kind) for key, kind in kinds.items()}
         return _Defaults(
             values={key: value for key, value in values.items() if value is not None},
@@ -617,7 +618,7 @@ class _Reader:
         role = table.get("role", _Choice(ROLES), required=True)
         position = table.get("position", _VECTOR, required=True)
         normal = _normal(table)
-        mu = _with_default(table, "mu", _POSITIVE, defaults, required=True)
+        mu = _with_default(table, "mu", _NONNEGATIVE, defaults, required=True)
         file_model = _with_default(table, "model", _MODEL, defaults, required=self.model is None)
         model = self.model or file_model
         if self.model in AREA_MODEL_NAMES and "patch" not in table.data:

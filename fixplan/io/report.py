@@ -362,6 +362,12 @@ def _draw_figures(problem, plan, planner, load, subspace, writer) -> tuple[list,
     for i, (contact, model) in enumerate(zip(problem.contacts, planner.models, strict=True)):
         if not model.torsion:
             continue
+        if model.frictionless:
+            notes.append(
+                f"Contact '{contact.name}' is frictionless (mu = 0): its friction set is the "
+                "single load 0, so it has no sections to draw."
+            )
+            continue
         if wrenches[i, 0] <= UNLOADED_RTOL * largest:
             notes.append(f"Contact '{contact.name}' carries no normal force in load case '{load}'.")
             continue

@@ -21,7 +21,9 @@ model                         torsion     motion  conservative  cvxpy form
 :class:`Exact`                yes         yes     no (±quad.)   one small cone per point
 ============================  ==========  ======  ============  ===========================
 
-Accuracy against the exact surface is measured by :func:`fixplan.models.compare.compare`.
+Every model accepts ``mu = 0``, a frictionless contact: its set is the load 0 and its
+constraints ``load == 0`` (see :mod:`fixplan.models.base`). Accuracy against the exact surface is
+measured by :func:`fixplan.models.compare.compare`.
 """
 
 from fixplan.models.base import ConicForm, FrictionModel

@@ -23,10 +23,23 @@ twists are still given and returned about the frame origin (DESIGN.md §2). Ther
 - as cvxpy constraints the set is ``g(q) <= N`` with ``q = (fx/mu, fy/mu, m/(mu rho))``, which
   is homogeneous in ``N``: ``N`` may be a float, a Parameter or an affine expression of
   variables (the normal force of a contact that the planner chooses).
+
+**Frictionless contacts** (``mu = 0``) transmit their normal force only: the set is the single
+load 0. Every model accepts ``mu = 0`` and keeps its shape (``rho``, tilt, centre, ...) from the
+pressure shape, as with ``mu = 1``; the normalised coordinates ``q`` are then those of that shape
+(:attr:`FrictionModel.friction_shape`). The set scales with ``mu``, so the sliding motion at a
+fixed load direction does not depend on ``mu`` and its limit ``mu → 0+`` is the motion of the
+shape. Hence, for ``mu = 0``:
+
+- the safety factor is ``inf`` for the zero load and 0 for any other; :meth:`contains` holds for
+  the zero load only; ``max_force`` and ``max_moment`` are 0 and :meth:`curve` is all zeros;
+- :meth:`motion` is that limit, the motion of the shape;
+- :meth:`constraints` states ``load == 0`` (homogeneous in ``N`` and DPP).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
@@ -47,8 +60,9 @@ _PLANES = {"fx-m": (0, 2), "fy-m": (1, 2), "fx-fy": (0, 1)}
 class FrictionModel(ABC):
     """A friction model: a convex set of loads, scaled by the normal force of its contact.
 
-    Subclasses are frozen dataclasses with the attributes ``mu`` [-], ``normal_force`` [N]
-    (the default of the numeric methods) and, for area models, ``rho`` [m].
+    Subclasses are frozen dataclasses with the attributes ``mu`` [-] (>= 0; 0 is a
+    frictionless contact), ``normal_force`` [N] (the default of the numeric methods) and, for
+    area models, ``rho`` [m].
     """
 
     __slots__ = ()
@@ -93,6 +107,27 @@ class FrictionModel(ABC):
         """Point [m] about which the model takes moments: the centre of pressure."""
         return (0.0, 0.0)
 
+    @property
+    def frictionless(self) -> bool:
+        """Whether the contact has no friction (``mu = 0``): it transmits normal force only."""
+        return self.mu == 0.0
+
+    @property
+    def _shape_mu(self) -> float:
+        """Friction coefficient of the normalised coordinates: ``mu``, or 1 for a frictionless
+        model (the coordinates of its shape)."""
+        return self.mu if self.mu > 0.0 else 1.0
+
+    @property
+    def friction_shape(self) -> FrictionModel:
+        """A model of this one's shape: itself, or for a frictionless model the same model with
+        the friction of its shape (``mu = 1``), which shrinks onto 0 as ``mu → 0+``."""
+        return self._with_shape_friction() if self.frictionless else self
+
+    def _with_shape_friction(self) -> FrictionModel:
+        """This frictionless model with ``mu`` set to :attr:`_shape_mu`."""
+        return dataclasses.replace(self, mu=self._shape_mu)
+
     def _about_center(self, loads: np.ndarray) -> np.ndarray:
         """Loads ``(K, 3)`` with the moment taken about :attr:`center`: ``m - c × f``."""
         cx, cy = self.center
@@ -124,10 +159,12 @@ class FrictionModel(ABC):
         return self.mu * self.rho * self.normal_force
 
     def _units(self) -> np.ndarray:
-        """Normalisation per unit normal force: ``(mu, mu, mu rho)`` or ``(mu, mu)``."""
+        """Normalisation per unit normal force: ``(mu, mu, mu rho)`` or ``(mu, mu)``, with
+        ``mu`` that of the shape for a frictionless model."""
+        mu = self._shape_mu
         if self.torsion:
-            return np.array([self.mu, self.mu, self.mu * self.rho])
-        return np.array([self.mu, self.mu])
+            return np.array([mu, mu, mu * self.rho])
+        return np.array([mu, mu])
 
     # -- numeric queries ---------------------------------------------------------------------
 
@@ -163,11 +200,14 @@ class FrictionModel(ABC):
         -------
         float or numpy.ndarray
             ``inf`` for the zero load; ``s > 1``: held with that margin; ``s < 1``: slides.
+            A frictionless model gives 0 for every nonzero load.
         """
         q, single, twisted = self._normalised(load, normal_force)
-        gauge = self._gauge(q)
-        with np.errstate(divide="ignore", over="ignore"):
-            safety = 1.0 / gauge
+        if self.frictionless:
+            safety = np.where(np.any(q != 0.0, axis=1), 0.0, np.inf)
+        else:
+            with np.errstate(divide="ignore", over="ignore"):
+                safety = 1.0 / self._gauge(q)
         safety[twisted] = 0.0
         return float(safety[0]) if single else safety
 
@@ -185,7 +225,9 @@ class FrictionModel(ABC):
         twist about :attr:`center`, ``(vx - cy w, vy + cx w, rho * w)``, has unit norm (for the
         standard fields ``center`` is the origin, as for ``LimitSurface.motion``); point models
         return the unit sliding velocity ``(vx, vy)`` (``(vx, vy, 0)`` for 3-vector loads).
-        NaN for the zero load and for a point model loaded by a moment.
+        NaN for the zero load and for a point model loaded by a moment. A frictionless model
+        returns the limit ``mu → 0+`` at the load's direction: the motion of its
+        :attr:`friction_shape`.
 
         Raises
         ------
@@ -225,7 +267,8 @@ class FrictionModel(ABC):
         Same conventions as :meth:`fixplan.LimitSurface.curve`: ``plane`` is ``"fx-m"``,
         ``"fy-m"`` or ``"fx-fy"`` (point models: ``"fx-fy"`` only); points evenly spread in
         angle in normalised coordinates. With ``normalized`` forces are divided by
-        ``max_force`` and moments by ``max_moment`` (both at ``normal_force``).
+        ``max_force`` and moments by ``max_moment`` (both at ``normal_force``). A frictionless
+        model's set is the load 0: every point is 0 (also normalised).
         """
         axes = _PLANES.get(plane)
         if axes is None:
@@ -238,6 +281,8 @@ class FrictionModel(ABC):
             raise InvalidArgumentError(f"n must be a positive integer, got {n!r}")
         force = self.normal_force if normal_force is None else normal_force
         force = validation.positive_scalar("normal_force", force)
+        if self.frictionless:
+            return np.zeros((int(n), 3))
         units = np.array([self.mu, self.mu, self.mu * self.rho]) * force
         directions = np.zeros((int(n), 3))
         directions[:, axes] = circle(int(n))
@@ -256,7 +301,7 @@ class FrictionModel(ABC):
         one cone constraint. ``load`` is ``(ft1, ft2, mn)`` [N, N, N m] about the frame origin
         (area models) or ``(ft1, ft2)`` [N] (point models).
         """
-        if self.mu == 0.0:  # frictionless: the load is zero
+        if self.frictionless:  # the load is zero
             width = self.load_dimension
             return ConicForm(
                 normal=np.zeros(width), load=np.eye(width), aux=np.zeros((width, 0)),
@@ -288,7 +333,7 @@ class FrictionModel(ABC):
         -------
         list of cvxpy.Constraint
             Convex and DPP (``problem.is_dcp(dpp=True)`` holds with Parameters): one per cone
-            kind of :meth:`conic_form`.
+            kind of :meth:`conic_form`. For a frictionless model: ``load == 0``.
         """
         import cvxpy as cp
 

@@ -12,6 +12,11 @@ the relative gap between the two boundaries along the ray (``s`` the safety fact
 ``e < 0``: it underestimates (conservative). For models with a motion map, the motion error is
 the angle between the predicted and the exact sliding twist for the same load, both written as
 ``(vx, vy, rho w)`` with the exact surface's ``rho`` (the paper's normalised coordinates).
+
+A frictionless surface (``mu = 0``) and a model built from it are both the single load 0. Every
+model scales with ``mu`` as the surface does, so their errors do not depend on ``mu``: they are
+compared on their shapes (``friction_shape``, ``mu = 1``), which gives the errors of the same
+model at any ``mu > 0``, and the motion errors of the limit ``mu → 0+``.
 """
 
 from __future__ import annotations
@@ -85,10 +90,12 @@ def load_directions(
     """``n`` loads ``(n, 3)`` of unit length in the surface's normalised coordinates.
 
     Evenly spread over the sphere (Fibonacci lattice) or, with ``plane`` (``"fx-m"``,
-    ``"fy-m"``, ``"fx-fy"``), evenly in angle in that plane.
+    ``"fy-m"``, ``"fx-fy"``), evenly in angle in that plane. A frictionless surface has the
+    coordinates of its shape (``mu = 1``).
     """
     if not isinstance(n, int | np.integer) or n < 1:
         raise InvalidArgumentError(f"n must be a positive integer, got {n!r}")
+    surface = surface.friction_shape
     units = np.array([surface.max_force, surface.max_force, surface.max_moment])
     if plane is None:
         return fibonacci_sphere(int(n)) * units
@@ -100,8 +107,20 @@ def load_directions(
     return directions * units
 
 
+def _shapes(model: FrictionModel, surface: LimitSurface) -> tuple[FrictionModel, LimitSurface]:
+    """The model and surface to compare: themselves, or the shapes of frictionless ones."""
+    if surface.frictionless and not model.frictionless:
+        raise InvalidArgumentError(
+            f"surface is frictionless (mu = 0) but model has mu = {model.mu:.6g}: a frictionless "
+            "contact holds only the load 0; compare a model built from the surface"
+        )
+    return model.friction_shape, surface.friction_shape
+
+
 def radial_errors(model: FrictionModel, surface: LimitSurface, loads) -> np.ndarray:
-    """Relative radial errors ``e`` ``(K,)`` of ``model`` along nonzero ``loads`` ``(K, 3)``."""
+    """Relative radial errors ``e`` ``(K,)`` of ``model`` along nonzero ``loads`` ``(K, 3)``
+    (of the shapes for a frictionless surface and model)."""
+    model, surface = _shapes(model, surface)
     exact = surface.safety_factor(loads)
     approx = model.safety_factor(loads, normal_force=surface.normal_force)
     return np.asarray(approx) / np.asarray(exact) - 1.0
@@ -114,6 +133,7 @@ def motion_angles(
 
     ``exact_motion`` ``(K, 3)`` reuses twists already computed by ``surface.motion``.
     """
+    model, surface = _shapes(model, surface)
     exact = surface.motion(loads) if exact_motion is None else exact_motion
     predicted = model.motion(loads, normal_force=surface.normal_force)
     scale = np.array([1.0, 1.0, surface.characteristic_length])
@@ -135,7 +155,9 @@ def compare(
     """Accuracy of ``model`` against the exact ``surface`` over ``n`` load directions.
 
     Point models (no torsion) are compared in the ``"fx-fy"`` plane, against the section
-    ``m = 0`` of the surface. The comparison is at the surface's normal force.
+    ``m = 0`` of the surface. The comparison is at the surface's normal force. A frictionless
+    surface and model are compared on their shapes (see the module docstring); a frictionless
+    surface with a model that has friction raises :class:`InvalidArgumentError`.
     """
     if not isinstance(model, FrictionModel):
         raise InvalidArgumentError(f"model must be a friction model, got {type(model).__name__}")
@@ -147,6 +169,8 @@ def compare(
                 f"a point model bears no moment: compare it in plane 'fx-fy', not {plane!r}"
             )
         plane = "fx-fy"
+    name = repr(model)
+    model, surface = _shapes(model, surface)
     loads = load_directions(surface, n, plane=plane)
     if model.has_motion:
         exact_motion, exact_safety = surface.motion_and_safety_factor(loads)
@@ -158,7 +182,7 @@ def compare(
     approx = model.safety_factor(loads, normal_force=surface.normal_force)
     errors = approx / exact_safety - 1.0
     return Accuracy(
-        model=repr(model),
+        model=name,
         directions=len(loads),
         plane=plane,
         max_overestimate=float(errors.max()),

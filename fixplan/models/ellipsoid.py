@@ -8,6 +8,7 @@ load (maximum power), so for the axisymmetric Table 2 ellipsoid
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, ClassVar
 
@@ -27,8 +28,8 @@ DEFAULT_FIT_SAMPLES = 1000
 
 
 def surface_units(ls: LimitSurface) -> tuple[float, float, float]:
-    """``(mu, rho, normal_force)`` of a limit surface: friction per unit normal force [-],
-    characteristic length [m] and normal force [N]."""
+    """``(mu, rho, normal_force)`` of a limit surface: friction per unit normal force [-] (0
+    for a frictionless surface), characteristic length [m] and normal force [N]."""
     from fixplan.surface.limit_surface import LimitSurface
 
     if not isinstance(ls, LimitSurface):
@@ -53,8 +54,10 @@ def surface_axis(ls: LimitSurface) -> tuple[tuple[float, float], float, tuple[fl
         Force ``(fx0, fy0)`` of the load at that largest moment, over ``max_force`` [-].
 
     Components below ``TILT_ATOL`` (of ``rho`` for the centre) are rounding noise of a
-    symmetric field and are set to 0.
+    symmetric field and are set to 0. A frictionless surface has those of its shape
+    (``ls.friction_shape``, the same patch with ``mu = 1``).
     """
+    ls = ls.friction_shape
     max_force, length = ls.max_force, ls.characteristic_length
     along_x, along_y = ls.load(np.eye(3)[:2])
     center = np.array([along_y[2], -along_x[2]]) / max_force
@@ -103,7 +106,7 @@ def limit_parameters(
 
 def check_area(model) -> None:
     """Validate and normalise the fields ``mu, rho, tilt, center, normal_force`` of ``model``."""
-    object.__setattr__(model, "mu", validation.positive_scalar("mu", model.mu))
+    object.__setattr__(model, "mu", validation.nonnegative_scalar("mu", model.mu))
     object.__setattr__(model, "rho", validation.positive_scalar("rho", model.rho))
     object.__setattr__(model, "tilt", finite_pair("tilt", model.tilt))
     object.__setattr__(model, "center", finite_pair("center", model.center))
@@ -151,9 +154,10 @@ class Ellipsoid(FrictionModel):
     Attributes
     ----------
     mu : float
-        Maximum friction force per unit normal force [-].
+        Maximum friction force per unit normal force [-]; 0 for a frictionless contact.
     rho : float
-        Maximum moment over maximum force [m] (the paper's ``lambda``).
+        Maximum moment over maximum force [m] (the paper's ``lambda``; of the pressure shape
+        when ``mu = 0``).
     tilt : tuple of float
         Force at maximum moment over the maximum force [-]; ``(0, 0)`` for symmetric pressure.
     center : tuple of float
@@ -239,7 +243,8 @@ class FittedEllipsoid(FrictionModel):
     matrix : numpy.ndarray
         ``M`` (3x3), in normalised coordinates ``q`` of ``mu`` and ``rho``.
     mu, rho : float
-        Normalisation units: friction per unit normal force [-] and length [m].
+        Normalisation units: friction per unit normal force [-] (0: frictionless, ``matrix``
+        is then the shape at ``mu = 1``) and length [m].
     center : tuple of float
         Point [m] about which the moments of ``q`` are taken (the centre of pressure).
     normal_force : float
@@ -269,7 +274,7 @@ class FittedEllipsoid(FrictionModel):
         factor.setflags(write=False)
         object.__setattr__(self, "matrix", matrix)
         object.__setattr__(self, "_factor", factor)
-        object.__setattr__(self, "mu", validation.positive_scalar("mu", self.mu))
+        object.__setattr__(self, "mu", validation.nonnegative_scalar("mu", self.mu))
         object.__setattr__(self, "rho", validation.positive_scalar("rho", self.rho))
         object.__setattr__(self, "center", finite_pair("center", self.center))
         object.__setattr__(
@@ -287,7 +292,8 @@ class FittedEllipsoid(FrictionModel):
 
         The directions are a Fibonacci lattice in the normalised coordinates of the Table 2
         ellipsoid (moments about the centre of pressure), so the fit does not depend on where
-        the frame origin lies.
+        the frame origin lies. A frictionless surface is fitted by the shape of its patch
+        (``mu = 1``) and gives a frictionless model.
         """
         if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 6:
             raise InvalidArgumentError(f"samples must be an integer >= 6, got {samples!r}")
@@ -299,7 +305,7 @@ class FittedEllipsoid(FrictionModel):
         cx, cy = frame.center
         loads = directions * units
         loads[:, 2] += cx * loads[:, 1] - cy * loads[:, 0]  # moments about the origin
-        points = directions * np.atleast_1d(ls.safety_factor(loads))[:, None]
+        points = directions * np.atleast_1d(ls.friction_shape.safety_factor(loads))[:, None]
         matrix, error = fit_ellipsoid(points)
         return cls(matrix=matrix, fit_error=error, **parameters)
 
@@ -424,7 +430,8 @@ class FacetedEllipsoid(FrictionModel):
     points : numpy.ndarray
         Support points ``(P, 2)`` [m].
     facet_support : numpy.ndarray
-        ``h(Vi)`` per unit normal force ``(P,)`` [m].
+        ``h(Vi)`` per unit normal force ``(P,)`` [m] (for a frictionless ellipsoid, that of the
+        pressure shape at ``mu = 1``).
     """
 
     ellipsoid: Ellipsoid | FittedEllipsoid
@@ -481,7 +488,7 @@ class FacetedEllipsoid(FrictionModel):
                 )
         points = validation.finite_array("points", points, shape=(None, 2))
         twists = np.column_stack([points[:, 1], -points[:, 0], np.ones(len(points))])
-        support = np.atleast_1d(ls.support(twists)) / normal_force
+        support = np.atleast_1d(ls.friction_shape.support(twists)) / normal_force
         return cls(ellipsoid=ellipsoid, points=points, facet_support=support)
 
     @property
@@ -499,6 +506,9 @@ class FacetedEllipsoid(FrictionModel):
     @property
     def normal_force(self) -> float:
         return self.ellipsoid.normal_force
+
+    def _with_shape_friction(self) -> FacetedEllipsoid:
+        return dataclasses.replace(self, ellipsoid=self.ellipsoid.friction_shape)
 
     def _pieces(self, q):
         """Gauges of the ellipsoid ``(K,)`` and of the facet pairs ``(K, P)``."""

@@ -13,10 +13,15 @@ paper §4.1), so the numeric methods use that surface (:attr:`Exact.surface`) an
 the constraints to solver accuracy. It differs from the exact surface of the continuous field
 by the quadrature error, which the model measures when it is built
 (:attr:`Exact.quadrature_error`). The error has both signs, so the model is not conservative.
+
+A frictionless contact keeps the per-point capacities of its shape (``mu = 1``) with
+``frictionless=True``: its set is the load 0 and its motion the limit ``mu → 0+``
+(:mod:`fixplan.models.base`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, ClassVar
 
@@ -47,7 +52,11 @@ class Exact(FrictionModel):
     points : numpy.ndarray
         Quadrature points ``(n, 2)`` [m] in the contact frame.
     capacity : numpy.ndarray
-        Friction force of each point per unit normal force, ``mu_j w_j`` ``(n,)`` [-].
+        Friction force of each point per unit normal force, ``mu_j w_j`` ``(n,)`` [-]; of a
+        frictionless model, that of its shape (``w_j``: ``mu = 1``).
+    frictionless : bool
+        Whether the contact has no friction (``mu = 0``); ``capacity`` then gives only the
+        shape, used by :meth:`motion`.
     normal_force : float
         Default normal force of the numeric methods [N].
     quadrature_error : float
@@ -59,6 +68,7 @@ class Exact(FrictionModel):
 
     points: np.ndarray
     capacity: np.ndarray
+    frictionless: bool = False
     normal_force: float = 1.0
     quadrature_error: float = float("nan")
     order: int | None = None
@@ -74,6 +84,11 @@ class Exact(FrictionModel):
         capacity = validation.finite_array("capacity", self.capacity, shape=(len(points),))
         if np.any(capacity < 0.0):
             raise InvalidArgumentError(f"capacity must be >= 0, got {capacity.min()!r}")
+        if not np.any(capacity > 0.0):
+            raise InvalidArgumentError(
+                "capacity must have a positive entry; for a frictionless contact pass "
+                "frictionless=True with the capacity of its shape (the force fractions w_j)"
+            )
         normal_force = validation.positive_scalar("normal_force", self.normal_force)
         loaded = capacity > 0.0
         points, capacity = points[loaded], capacity[loaded]
@@ -83,6 +98,7 @@ class Exact(FrictionModel):
         surface = LimitSurface(field_, mu=float(capacity.sum()), normal_force=1.0)
         object.__setattr__(self, "points", points)
         object.__setattr__(self, "capacity", capacity)
+        object.__setattr__(self, "frictionless", bool(self.frictionless))
         object.__setattr__(self, "normal_force", normal_force)
         object.__setattr__(self, "quadrature_error", float(self.quadrature_error))
         object.__setattr__(self, "_surface", surface)
@@ -91,32 +107,48 @@ class Exact(FrictionModel):
     def from_limit_surface(cls, ls: LimitSurface, *, order: int = DEFAULT_ORDER) -> Exact:
         """Discretise the field of ``ls`` with ``field.quadrature(order)`` and measure the error.
 
-        Works for constant and position-dependent ``mu`` and for combined surfaces (the
-        quadrature points of every part, weighted by its share of the normal force).
+        Works for constant and position-dependent ``mu``, for combined surfaces (the
+        quadrature points of every part, weighted by its share of the normal force) and for
+        frictionless surfaces (the points of the shape, ``frictionless=True``; the error is
+        that of the shape).
         """
         from fixplan.models.ellipsoid import surface_units
 
         surface_units(ls)
         if isinstance(order, bool) or not isinstance(order, int | np.integer) or order < 1:
             raise InvalidArgumentError(f"order must be a positive integer, got {order!r}")
-        points, capacity = _discretise(ls, int(order))
+        shape = ls.friction_shape
+        points, capacity = _discretise(shape, int(order))
         model = cls(
-            points=points, capacity=capacity, normal_force=ls.normal_force, order=int(order)
+            points=points,
+            capacity=capacity,
+            frictionless=ls.frictionless,
+            normal_force=ls.normal_force,
+            order=int(order),
         )
-        units = np.array([ls.max_force, ls.max_force, ls.max_moment])
+        units = np.array([shape.max_force, shape.max_force, shape.max_moment])
         loads = fibonacci_sphere(ERROR_DIRECTIONS) * units
-        error = np.max(np.abs(model.safety_factor(loads) / ls.safety_factor(loads) - 1.0))
+        approx = model.friction_shape.safety_factor(loads)
+        error = np.max(np.abs(approx / shape.safety_factor(loads) - 1.0))
         object.__setattr__(model, "quadrature_error", float(error))
         return model
 
     @property
     def surface(self) -> LimitSurface:
-        """Limit surface of the point set at unit normal force: the set the constraints state."""
+        """Limit surface of the point set at unit normal force: the set the constraints state
+        (of the shape for a frictionless model, whose set is the load 0)."""
         return self._surface
 
     @property
     def mu(self) -> float:
+        return 0.0 if self.frictionless else self._shape_mu
+
+    @property
+    def _shape_mu(self) -> float:
         return float(self.capacity.sum())
+
+    def _with_shape_friction(self) -> Exact:
+        return dataclasses.replace(self, frictionless=False)
 
     @property
     def rho(self) -> float:

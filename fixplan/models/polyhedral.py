@@ -51,9 +51,9 @@ class Cone(FrictionModel):
     Attributes
     ----------
     mu : float
-        Maximum friction force per unit normal force [-].
+        Maximum friction force per unit normal force [-]; 0 for a frictionless contact.
     rho : float
-        Maximum moment over maximum force [m].
+        Maximum moment over maximum force [m] (of the pressure shape when ``mu = 0``).
     tilt : tuple of float
         Force at maximum moment over the maximum force [-].
     center : tuple of float
@@ -242,13 +242,15 @@ class Pyramid(FrictionModel):
         """``(A, b)`` with the pyramid ``{L : A @ L <= b}`` for loads ``L`` [N, N, N m].
 
         ``A`` is ``(2k, 3)``, ``b`` ``(2k,)`` [N]; ``normal_force`` [N] defaults to the model's.
+        A frictionless model gives ``A`` of its shape and ``b = 0``: the pyramid is bounded, so
+        ``A @ L <= 0`` holds for ``L = 0`` only.
         """
         force = self.normal_force if normal_force is None else normal_force
         force = validation.positive_scalar("normal_force", force)
         cx, cy = self.center
         about_center = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [cy, -cx, 1.0]])
         matrix = self._rows / self._units()[None, :] @ about_center
-        return matrix, np.full(len(self._rows), force)
+        return matrix, np.full(len(self._rows), 0.0 if self.frictionless else force)
 
     def _gauge(self, q):
         t = self.tilt
@@ -293,7 +295,7 @@ class PointCone(FrictionModel):
     Attributes
     ----------
     mu : float
-        Friction coefficient [-].
+        Friction coefficient [-]; 0 for a frictionless contact.
     normal_force : float
         Default normal force of the numeric methods [N].
     """
@@ -305,7 +307,7 @@ class PointCone(FrictionModel):
     torsion: ClassVar[bool] = False
 
     def __post_init__(self):
-        object.__setattr__(self, "mu", validation.positive_scalar("mu", self.mu))
+        object.__setattr__(self, "mu", validation.nonnegative_scalar("mu", self.mu))
         object.__setattr__(
             self, "normal_force", validation.positive_scalar("normal_force", self.normal_force)
         )
@@ -356,7 +358,7 @@ class PointPyramid(FrictionModel):
     torsion: ClassVar[bool] = False
 
     def __post_init__(self):
-        object.__setattr__(self, "mu", validation.positive_scalar("mu", self.mu))
+        object.__setattr__(self, "mu", validation.nonnegative_scalar("mu", self.mu))
         object.__setattr__(
             self, "normal_force", validation.positive_scalar("normal_force", self.normal_force)
         )
@@ -380,10 +382,14 @@ class PointPyramid(FrictionModel):
         return cls(mu=mu, facets=facets, inscribed=inscribed, normal_force=normal_force)
 
     def inequalities(self, *, normal_force: float | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """``(A, b)`` with the pyramid ``{f : A @ f <= b}`` for forces ``(fx, fy)`` [N]."""
+        """``(A, b)`` with the pyramid ``{f : A @ f <= b}`` for forces ``(fx, fy)`` [N].
+
+        A frictionless model gives ``b = 0``: ``A @ f <= 0`` holds for ``f = 0`` only.
+        """
         force = self.normal_force if normal_force is None else normal_force
         force = validation.positive_scalar("normal_force", force)
-        return self._rows / self.mu, np.full(len(self._rows), force)
+        rows = self._rows / self._shape_mu
+        return rows, np.full(len(self._rows), 0.0 if self.frictionless else force)
 
     def _gauge(self, q):
         apothem = _apothem(self.facets, self.inscribed)

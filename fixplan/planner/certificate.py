@@ -41,7 +41,7 @@ def certificate(
             else ""
         )
         lines.append(
-            f"load case {load.name!r} cannot be held{cause}; nothing resists the motion in which "
+            f"load case {load.name!r} cannot be held{cause}: nothing resists the motion in which "
             f"the body {screw.describe()}"
         )
     if not lines:

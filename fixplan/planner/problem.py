@@ -149,7 +149,8 @@ class Contact:
     normal : array (3,)
         Direction in which the contact pushes the body (into the body); normalised.
     mu : float
-        Friction coefficient, > 0.
+        Friction coefficient, >= 0; 0 is a frictionless contact (a frictionless clamp or
+        locator), which transmits its normal force only.
     model : str or friction model
         ``"exact"``, ``"ellipsoid"``, ``"cone"``, ``"pyramid"`` (need a ``patch``),
         ``"point-cone"``, ``"point-pyramid"``, or a model object from :mod:`fixplan.models`
@@ -189,7 +190,7 @@ class Contact:
             raise ProblemError(f"{where}.role must be one of {', '.join(ROLES)}; got {self.role!r}")
         object.__setattr__(self, "position", _vector(f"{where}.position", self.position))
         object.__setattr__(self, "normal", _vector(f"{where}.normal", self.normal, unit=True))
-        object.__setattr__(self, "mu", _scalar(f"{where}.mu", self.mu, positive=True))
+        object.__setattr__(self, "mu", _scalar(f"{where}.mu", self.mu))
         if self.patch is not None and not isinstance(self.patch, PressureField):
             raise ProblemError(f"{where}.patch must be a pressure field, got {self.patch!r}")
         self._check_model(where)

@@ -19,6 +19,12 @@ Accuracy (relative, measured by the tests against independent quadrature):
   of rotation, better than 1e-9 for smooth integrands (1e-7 with a Hertz profile);
 - inverse map (safety factor, motion): Newton's method to 1e-12 on the twist, so the safety
   factor matches the forward map to about 1e-15 and motions are within 1e-10 rad.
+
+A frictionless contact (``mu = 0``) transmits its normal force only: ``h = 0``, its limit
+surface is the single load 0 and every other load slides (safety factor 0). Its shape is that of
+the same patch with ``mu = 1`` (:attr:`LimitSurface.friction_shape`), which shrinks onto 0 as
+``mu → 0+``; the sliding motion at a fixed load direction does not change along the way, so
+:meth:`LimitSurface.motion` returns that limit, the motion of the shape.
 """
 
 from __future__ import annotations
@@ -71,14 +77,15 @@ class LimitSurface:
     field : PressureField
         Pressure distribution, normalised to unit total; coordinates [m].
     mu : float or callable
-        Friction coefficient, a constant >= 0 or a function ``mu(x, y)`` of contact-frame
-        coordinates [m] returning arrays. A function must be smooth over the patch; a patch of
-        two materials is two patches summed with :meth:`combine`.
+        Friction coefficient, a constant >= 0 or a function ``mu(x, y)`` >= 0 of contact-frame
+        coordinates [m] returning arrays. A function must be smooth over the patch and positive
+        somewhere on it; a patch of two materials is two patches summed with :meth:`combine`.
+        ``mu = 0`` is a frictionless contact (see the module docstring).
     normal_force : float
         Total normal force [N], > 0.
     """
 
-    __slots__ = ("_kernel", "_mu", "_normal_force", "_parts", "_scale", "_units", "field")
+    __slots__ = ("_kernel", "_mu", "_normal_force", "_parts", "_scale", "_shape", "_units", "field")
 
     def __init__(self, field: PressureField, *, mu: float | Callable, normal_force: float = 1.0):
         if not isinstance(field, PressureField):
@@ -89,17 +96,26 @@ class LimitSurface:
         if callable(mu):
             kernel, scale = _varying_friction_kernel(field, mu), normal_force
         else:
-            mu = validation.positive_scalar("mu", mu)
+            mu = validation.nonnegative_scalar("mu", mu)
             kernel, scale = _field_kernel(field), mu * normal_force
         self.field = field
         self._mu = mu
         self._normal_force = normal_force
         self._parts: tuple[LimitSurface, ...] = ()
-        self._setup(kernel, scale)
+        frictionless = not callable(mu) and mu == 0.0
+        shape = LimitSurface(field, mu=1.0, normal_force=normal_force) if frictionless else None
+        self._setup(kernel, scale, shape)
+        if callable(mu) and self.max_force == 0.0:
+            raise InvalidArgumentError(
+                "mu(x, y) is 0 over the whole patch: pass mu=0 for a frictionless contact"
+            )
 
-    def _setup(self, kernel: SupportKernel, scale: float) -> None:
+    def _setup(
+        self, kernel: SupportKernel, scale: float, shape: LimitSurface | None = None
+    ) -> None:
         self._kernel = kernel
         self._scale = scale
+        self._shape = shape
         probe = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
         max_force, max_moment = scale * kernel.support(probe)
         self._units = np.array([max_force, max_force, max_moment])
@@ -120,7 +136,11 @@ class LimitSurface:
         combined._normal_force = sum(p.normal_force for p in parts)
         combined._parts = parts
         kernel = SumKernel(tuple(p._kernel for p in parts), tuple(p._scale for p in parts))
-        combined._setup(kernel, 1.0)
+        # Frictionless parts add nothing; when every part is frictionless, so is the sum, and
+        # its shape is the sum of the parts' shapes.
+        frictionless = all(p.frictionless for p in parts)
+        shape = cls.combine(p.friction_shape for p in parts) if frictionless else None
+        combined._setup(kernel, 1.0, shape)
         return combined
 
     # -- description ------------------------------------------------------------------------
@@ -129,6 +149,17 @@ class LimitSurface:
     def mu(self) -> float | Callable | None:
         """Friction coefficient (``None`` for a combined surface)."""
         return self._mu
+
+    @property
+    def frictionless(self) -> bool:
+        """Whether the contact has no friction (``mu = 0``): its limit surface is the load 0."""
+        return self._shape is not None
+
+    @property
+    def friction_shape(self) -> LimitSurface:
+        """A surface of this one's shape: itself, or for a frictionless surface the same
+        patches with ``mu = 1`` (the surface that shrinks onto 0 as ``mu → 0+``)."""
+        return self if self._shape is None else self._shape
 
     @property
     def normal_force(self) -> float:
@@ -152,8 +183,10 @@ class LimitSurface:
 
     @property
     def characteristic_length(self) -> float:
-        """``rho = max_moment / max_force`` [m], the scale of the paper's normalised plots."""
-        return self.max_moment / self.max_force
+        """``rho = max_moment / max_force`` [m], the scale of the paper's normalised plots
+        (of a frictionless surface: that of its :attr:`friction_shape`)."""
+        shape = self.friction_shape
+        return shape.max_moment / shape.max_force
 
     def __repr__(self) -> str:
         what = f"{len(self._parts)} parts" if self._parts else type(self.field).__name__
@@ -197,6 +230,10 @@ class LimitSurface:
 
     def _inverse(self, load):
         loads, single = validation.vector_batch("load", load, width=3)
+        if self._shape is not None:
+            # Frictionless: only the load 0 is held; the motion is the limit mu -> 0+.
+            safety = np.where(np.any(loads != 0.0, axis=1), 0.0, np.inf)
+            return safety, self._shape._inverse(loads)[1], single
         safety = np.full(len(loads), np.inf)
         twists = np.full((len(loads), 3), np.nan)
         nonzero = np.flatnonzero(np.any(loads != 0.0, axis=1))
@@ -213,7 +250,8 @@ class LimitSurface:
     def safety_factor(self, load) -> np.ndarray | float:
         """Factor ``s`` with ``s * load`` on the surface (``inf`` for the zero load).
 
-        ``s > 1``: held with that margin; ``s < 1``: the contact slides.
+        ``s > 1``: held with that margin; ``s < 1``: the contact slides. A frictionless surface
+        gives 0 for every nonzero load.
         """
         safety, _, single = self._inverse(load)
         return float(safety[0]) if single else safety
@@ -229,7 +267,8 @@ class LimitSurface:
 
         For a load inside the surface it is the motion the load would cause if scaled up to the
         surface. Scaled so that ``(vx, vy, rho * w)`` has unit norm,
-        ``rho = characteristic_length``.
+        ``rho = characteristic_length``. For a frictionless surface it is the limit ``mu → 0+``
+        at the load's direction: the motion of the same patch with ``mu = 1``.
         """
         _, twists, single = self._inverse(load)
         return self._unit_twists(twists[0] if single else twists)
@@ -253,7 +292,8 @@ class LimitSurface:
         ``plane`` is ``"fx-m"``, ``"fy-m"`` or ``"fx-fy"`` (the third coordinate is zero); the
         points are spread evenly in angle in normalised coordinates, counter-clockwise from the
         first axis (paper Figs. 2, 3, 5). With ``normalized`` forces are divided by
-        ``max_force`` and moments by ``max_moment``.
+        ``max_force`` and moments by ``max_moment``. A frictionless surface is the load 0: every
+        point is 0 (also normalised).
         """
         axes = _PLANES.get(plane)
         if axes is None:
@@ -272,6 +312,8 @@ class LimitSurface:
         return self._radial(fibonacci_sphere(_count("n", n)), normalized)
 
     def _radial(self, directions: np.ndarray, normalized: bool) -> np.ndarray:
+        if self.frictionless:
+            return np.zeros_like(directions)
         loads = directions * self._units
         loads = loads * self._inverse(loads)[0][:, None]
         return loads / self._units if normalized else loads
