@@ -121,6 +121,13 @@ class Planner:
         residual, problems = verify(
             self.problem, self.layout, self.models, result, wrenches, self.length_scale
         )
+        if problems and result["solver"].startswith("CLARABEL"):
+            retry = self._squeeze_free(objective, wrenches, given, squeezed, accurate=True)
+            if retry["status"] == "optimal":
+                result = self._refine(objective, retry, wrenches, given, squeezed)
+                residual, problems = verify(
+                    self.problem, self.layout, self.models, result, wrenches, self.length_scale
+                )
         if problems:
             status = "inaccurate"
             notes += problems
@@ -152,12 +159,15 @@ class Planner:
 
     # -- stages -------------------------------------------------------------------------------
 
-    def _squeeze_free(self, objective, wrenches, given, squeezed, *, sense=1.0, progress=None):
+    def _squeeze_free(
+        self, objective, wrenches, given, squeezed, *, sense=1.0, accurate=False, progress=None
+    ):
         """Solve ``objective``, unloading passive contacts until no case holds a squeeze.
 
         ``squeezed`` collects, per load case name, the contacts unloaded (for the notes).
         """
-        result = self._runner.run(objective, wrenches, given, sense=sense, progress=progress)
+        options = {"sense": sense, "accurate": accurate, "progress": progress}
+        result = self._runner.run(objective, wrenches, given, **options)
         if not self.squeeze_contacts:
             return result
         passive_map = self.layout.normal_map[:, self._passive]
@@ -170,9 +180,7 @@ class Planner:
             if not more.any():
                 break
             unloaded |= more
-            result = self._runner.run(
-                objective, wrenches, given, sense=sense, unloaded=unloaded, progress=progress
-            )
+            result = self._runner.run(objective, wrenches, given, unloaded=unloaded, **options)
         for j, name in enumerate(load.name for load in self.problem.loads):
             found = tuple(n for n, u in zip(passive_names, unloaded[:, j], strict=True) if u)
             if found:

@@ -30,14 +30,19 @@ DPP_MAX_VARIABLES = 20_000
 CASES_PER_BLOCK = 64
 
 _FALLBACK = {"CLARABEL": "SCS", "SCS": "CLARABEL", "OSQP": "CLARABEL"}
+#: Clarabel's iterative refinement of the KKT solves is off: it takes about half of the solve
+#: time (a 200-contact x 200-case fixture: 6.5 s with it, 3.5 s without, the same iterations),
+#: and every answer is verified in numpy anyway (a failed verification retries with SCS).
 _SOLVER_OPTIONS = {
-    "CLARABEL": {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9},
+    "CLARABEL": {
+        "tol_gap_abs": 1e-9,
+        "tol_gap_rel": 1e-9,
+        "tol_feas": 1e-9,
+        "iterative_refinement_enable": False,
+    },
     "SCS": {"eps": 1e-9, "max_iters": 200_000},
     "OSQP": {"eps_abs": 1e-8, "eps_rel": 1e-8, "max_iter": 50_000, "polish": True},
 }
-#: Clarabel settings of the direct re-solves: iterative refinement of the KKT solves is off
-#: (a third of the time on the fixture benchmark); every answer is verified in numpy anyway.
-_DIRECT_OPTIONS = {**_SOLVER_OPTIONS["CLARABEL"], "iterative_refinement_enable": False}
 _STATUS = {
     cp.OPTIMAL: "optimal",
     cp.OPTIMAL_INACCURATE: "inaccurate",
@@ -88,14 +93,16 @@ class Runner:
         *,
         sense: float = 1.0,
         unloaded: np.ndarray | None = None,
+        accurate: bool = False,
         progress=None,
     ) -> dict:
         """Solve all load cases (task ``wrenches`` ``(6, K)``), block by block.
 
         ``given`` maps contact index -> its given normal force (float or ``(K,)``) [N];
         ``sense`` -1 minimises the task-load multiples instead of maximising them;
-        ``unloaded`` ``(passive, K)`` marks passive contacts held without normal force. The
-        last block is padded with copies of its first case.
+        ``unloaded`` ``(passive, K)`` marks passive contacts held without normal force;
+        ``accurate`` turns Clarabel's iterative refinement on (for a retry when an answer failed
+        verification). The last block is padded with copies of its first case.
         """
         cases = wrenches.shape[1]
         block = self.block_size(objective)
@@ -108,13 +115,13 @@ class Runner:
                 for i, v in given.items()
             }
             mask = None if unloaded is None else unloaded[:, padded]
-            result = self._run_block(objective, wrenches[:, padded], values, sense, mask)
+            result = self._run_block(objective, wrenches[:, padded], values, sense, mask, accurate)
             results.append((result, len(index)))
             if progress is not None:
                 progress(int(index[-1]) + 1, cases)
         return _merge(results)
 
-    def _run_block(self, objective, wrenches, given, sense, unloaded) -> dict:
+    def _run_block(self, objective, wrenches, given, sense, unloaded, accurate) -> dict:
         stacked = self.stacked(objective)
         stacked.task.value = wrenches
         stacked.gravity.value = self.problem.body.weight_wrench
@@ -125,12 +132,12 @@ class Runner:
             stacked.unloaded.value = (
                 np.zeros(stacked.unloaded.shape) if unloaded is None else unloaded.astype(float)
             )
-        direct = self._direct_result(objective, stacked)
+        direct = None if accurate else self._direct_result(objective, stacked)
         if direct is not None:
             return direct
         notes = []
         solver = self.solver
-        status = _call(stacked.problem, solver)
+        status = _call(stacked.problem, solver, accurate=accurate)
         if status == "optimal":
             self._prepare_direct(objective, stacked)
         if status in ("solver-error", "inaccurate"):
@@ -171,7 +178,9 @@ class Runner:
             return
         self._solves[objective] = self._solves.get(objective, 0) + 1
         if self._solves[objective] >= 2:
-            self._direct[objective] = DirectSolver.create(stacked.problem, _DIRECT_OPTIONS)
+            self._direct[objective] = DirectSolver.create(
+                stacked.problem, _SOLVER_OPTIONS["CLARABEL"]
+            )
 
 
 def _values(stacked: Stacked) -> dict:
@@ -182,14 +191,17 @@ def _values(stacked: Stacked) -> dict:
     }
 
 
-def _call(problem: cp.Problem, solver: str) -> str:
+def _call(problem: cp.Problem, solver: str, *, accurate: bool = False) -> str:
     # cvxpy's DPP compilation grows faster than the problem: past DPP_MAX_VARIABLES
     # canonicalising afresh is quicker than compiling the parameter map.
     large = problem.size_metrics.num_scalar_variables > DPP_MAX_VARIABLES
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            problem.solve(solver=solver, ignore_dpp=large, **_SOLVER_OPTIONS[solver])
+            options = dict(_SOLVER_OPTIONS[solver])
+            if accurate and solver == "CLARABEL":
+                options["iterative_refinement_enable"] = True
+            problem.solve(solver=solver, ignore_dpp=large, **options)
     except cp.error.SolverError as exc:
         if solver == "OSQP" and "QP" in str(exc):
             raise InvalidArgumentError(
