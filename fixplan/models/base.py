@@ -396,6 +396,27 @@ class ConicForm:
         """Number of rows ``r``."""
         return len(self.normal)
 
+    @property
+    def bounds_normal(self) -> bool:
+        """Whether the cones imply ``N >= 0`` on their own (a cone's first row is ``a N`` with
+        ``a > 0``, or the first rows and inequalities add up to a positive multiple of ``N``):
+        then the planner needs no separate sign constraint on the normal force."""
+        first = [self.rows_of("soc", size)[::size] for size in self._soc_sizes]
+        rows = np.concatenate([*first, self.rows_of("nonneg")]).astype(int)
+        if rows.size == 0:
+            return False
+        coefficients = np.hstack([self.load[rows], self.aux[rows]])
+        scale = max(float(np.abs(coefficients).max(initial=0.0)), 1e-300)
+        pure = (np.abs(coefficients).max(axis=1, initial=0.0) <= 1e-12 * scale) & (
+            self.normal[rows] > 0.0
+        )
+        total = np.abs(coefficients.sum(axis=0)).max(initial=0.0) <= 1e-12 * scale * len(rows)
+        return bool(pure.any() or (total and self.normal[rows].sum() > 0.0))
+
+    @property
+    def _soc_sizes(self) -> list[int]:
+        return sorted({size for kind, size in self.cones if kind == "soc"})
+
     def rows_of(self, kind: str, size: int | None = None) -> np.ndarray:
         """Indices of the rows in cones of ``kind`` (and ``size``), cone after cone."""
         found, start = [], 0
@@ -415,7 +436,7 @@ class ConicForm:
             if index.size:
                 part = rows[index, :]
                 constraints.append(part == 0 if kind == "zero" else part >= 0)
-        for size in sorted({s for kind, s in self.cones if kind == "soc"}):
+        for size in self._soc_sizes:
             index = self.rows_of("soc", size)
             constraints.append(soc_columns(rows[index, :], size))
         return constraints

@@ -49,6 +49,9 @@ class ContactLayout:
         (``kind`` ``"zero"``, ``"nonneg"`` or ``"soc"``; ``size`` 0 for the first two).
     aux_size : int
         Auxiliary variables per load case.
+    signed : numpy.ndarray
+        ``(C,)`` bool: the friction set does not imply a nonnegative normal force (a
+        frictionless contact), so the planner states it.
     """
 
     normal_map: np.ndarray
@@ -56,6 +59,7 @@ class ContactLayout:
     slices: tuple[slice, ...]
     cones: dict
     aux_size: int
+    signed: np.ndarray
 
     @classmethod
     def of(cls, problem: Problem, models: list[FrictionModel]) -> ContactLayout:
@@ -74,6 +78,7 @@ class ContactLayout:
             slices=slices,
             cones=_stack_cones(forms, starts, aux_starts),
             aux_size=int(aux_starts[-1]),
+            signed=np.array([not form.bounds_normal for form in forms]),
         )
 
 
@@ -173,10 +178,12 @@ def build(
         role = "passive" if contact.role in PASSIVE_ROLES else contact.role
         groups[f"given-{role}" if given(contact) else role].append(i)
     ones = np.ones((1, cases))
+    # Normal forces are nonnegative; most friction sets imply it (a cone's first row), and only
+    # the others get a sign constraint, which keeps the conic problem small.
     pieces = {
-        "passive": cp.Variable((len(groups["passive"]), cases), nonneg=True, name="passive"),
-        "finger": cp.Variable((len(groups["finger"]), cases), nonneg=True, name="fingers"),
-        "clamp": cp.Variable(len(groups["clamp"]), nonneg=True, name="clamps"),
+        "passive": cp.Variable((len(groups["passive"]), cases), name="passive"),
+        "finger": cp.Variable((len(groups["finger"]), cases), name="fingers"),
+        "clamp": cp.Variable(len(groups["clamp"]), name="clamps"),
         "given-finger": cp.Parameter((len(groups["given-finger"]), cases), nonneg=True),
         "given-clamp": cp.Parameter(len(groups["given-clamp"]), nonneg=True),
     }
@@ -194,6 +201,10 @@ def build(
     aux = cp.Variable((layout.aux_size, cases), name="aux") if layout.aux_size else None
 
     constraints = []
+    for key in ("passive", "finger", "clamp"):
+        rows = [k for k, i in enumerate(groups[key]) if layout.signed[i]]
+        if rows:
+            constraints.append(pieces[key][rows] >= 0.0)
     task = cp.Parameter((6, cases), name="task_wrenches")
     gravity = cp.Parameter(6, name="gravity_wrench")
     sense = None
