@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fixplan.planner.screw import Screw
+from fixplan.tolerances import HELD_RTOL
 
 STATUSES = ("optimal", "infeasible", "unbounded", "inaccurate", "solver-error")
 
@@ -105,6 +106,28 @@ class Plan:
         """Whether the status is ``"optimal"``."""
         return self.status == "optimal"
 
+    def describe_held(self, load_name: str) -> str:
+        """Whether load case ``load_name`` is held, and for which multiples of its task load,
+        in words (e.g. ``"held for 0.61–2.05 × the task load"``)."""
+        if load_name not in self.held_intervals:
+            return "not analysed"
+        low, high = self.held_intervals[load_name]
+        span = (
+            f"{_multiple(low)} × the task load and above"
+            if np.isinf(high)
+            else f"{_multiple(low)}–{_multiple(high)} × the task load"
+        )
+        if self.held.get(load_name):
+            if high - low <= HELD_RTOL * high:
+                return "held at the task load only, with no margin either way"
+            return f"held for {span}"
+        if low > 0.0:
+            return (
+                "not held even without the task load: the active forces themselves push the "
+                f"part out (held only for {span})"
+            )
+        return f"not held: slides above {_multiple(high)} × the task load (held for {span})"
+
     def as_dict(self) -> dict:
         """JSON-ready description of the plan."""
 
@@ -129,6 +152,7 @@ class Plan:
                 k: [number(low), number(high)] for k, (low, high) in self.held_intervals.items()
             },
             "held": dict(self.held),
+            "held_descriptions": {name: self.describe_held(name) for name in self.held_intervals},
             "critical_load": self.critical_load,
             "critical_contact": self.critical_contact,
             "motions": {k: (None if m is None else m.as_dict()) for k, m in self.motions.items()},
@@ -156,6 +180,11 @@ class Plan:
             "warnings": list(self.warnings),
             "solver": self.solver,
         }
+
+
+def _multiple(value: float) -> str:
+    """A multiple of a task load for words: 3 significant digits, 0 as 0."""
+    return "0" if value == 0.0 else f"{value:.3g}"
 
 
 __all__ = ["STATUSES", "Plan", "Screw"]
