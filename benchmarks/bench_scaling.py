@@ -40,8 +40,13 @@ def plate_fixture(contacts: int, cases: int, model: str, seed: int = 0) -> Probl
     def add(role, position, normal, patch):
         items.append(
             Contact(
-                name=f"{role}-{len(items)}", role=role, position=position, normal=normal, mu=0.3,
-                model=model, patch=patch,
+                name=f"{role}-{len(items)}",
+                role=role,
+                position=position,
+                normal=normal,
+                mu=0.3,
+                model=model,
+                patch=patch,
             )  # fmt: skip
         )
 
@@ -95,6 +100,32 @@ def one_row(contacts: int, cases: int, model: str) -> dict:
     }  # fmt: skip
 
 
+def dpp_table() -> None:
+    """When cvxpy's DPP compilation pays: first solve and median re-solve with and without it."""
+    import cvxpy as cp
+
+    print("DPP: total time of a solve through cvxpy [s] (first / median of 2 re-solves)")
+    for contacts, cases in ((8, 20), (50, 20), (200, 20), (50, 100), (200, 100)):
+        problem = plate_fixture(contacts, cases, "ellipsoid")
+        times = {}
+        for dpp in (True, False):
+            stacked = Planner(problem)._runner.stacked(problem.objective)
+            stacked.gravity.value = problem.body.weight_wrench
+            runs = []
+            for seed in range(3):
+                stacked.task.value = np.column_stack([x.wrench for x in milling_loads(cases, seed)])
+                start = time.perf_counter()
+                stacked.problem.solve(solver=cp.CLARABEL, ignore_dpp=not dpp,
+                                      iterative_refinement_enable=False)  # fmt: skip
+                runs.append(time.perf_counter() - start)
+            times[dpp] = (runs[0], float(np.median(runs[1:])))
+        size = stacked.problem.size_metrics.num_scalar_variables
+        print(
+            f"  {contacts:4d} x {cases:4d} ({size:6d} variables): DPP {times[True][0]:.3f} / "
+            f"{times[True][1]:.3f}, without {times[False][0]:.3f} / {times[False][1]:.3f}"
+        )
+
+
 def main() -> None:
     rows = []
     for model in MODELS:
@@ -125,6 +156,7 @@ def main() -> None:
             f"build+first x{top['build_and_first'] / base['build_and_first']:.0f}, "
             f"memory x{top['peak_mb'] / base['peak_mb']:.1f}"
         )
+    dpp_table()
 
 
 if __name__ == "__main__":
