@@ -47,7 +47,7 @@ def plate_fixture(contacts: int, cases: int, model: str, seed: int = 0) -> Probl
                 mu=0.3,
                 model=model,
                 patch=patch,
-            )  # fmt: skip
+            )
         )
 
     for x, y in rng.uniform([-0.2, -0.15], [0.2, 0.15], size=(supports, 2)):
