@@ -26,7 +26,8 @@ constraints ``load == 0`` (see :mod:`fixplan.models.base`). Accuracy against the
 measured by :func:`fixplan.models.compare.compare`.
 """
 
-from fixplan.models.base import ConicForm, FrictionModel
+from fixplan.models.base import FrictionModel
+from fixplan.models.conic import ConicForm
 from fixplan.models.ellipsoid import Ellipsoid, FacetedEllipsoid, FittedEllipsoid, fit_ellipsoid
 from fixplan.models.exact import Exact
 from fixplan.models.polyhedral import Cone, PointCone, PointPyramid, Pyramid

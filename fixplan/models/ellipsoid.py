@@ -16,7 +16,8 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import ConvergenceError, InvalidArgumentError
-from fixplan.models.base import FrictionModel, finite_pair, fmt, unit_conic
+from fixplan.models.base import FrictionModel, finite_pair, fmt
+from fixplan.models.conic import unit_conic
 from fixplan.surface.sphere import fibonacci_sphere
 from fixplan.tolerances import FIT_MIN_EIGENVALUE, TILT_ATOL
 

@@ -29,7 +29,8 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError
-from fixplan.models.base import FrictionModel, fmt, unit_conic
+from fixplan.models.base import FrictionModel, fmt
+from fixplan.models.conic import unit_conic
 from fixplan.surface.sphere import fibonacci_sphere
 
 if TYPE_CHECKING:  # pragma: no cover

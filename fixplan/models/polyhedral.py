@@ -16,7 +16,8 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError
-from fixplan.models.base import FrictionModel, facet_count, fmt, polygon_normals, unit_conic
+from fixplan.models.base import FrictionModel, facet_count, fmt, polygon_normals
+from fixplan.models.conic import unit_conic
 from fixplan.models.ellipsoid import (
     _shear,
     area_parameters,

@@ -23,7 +23,8 @@ import cvxpy as cp
 import numpy as np
 import scipy.sparse as sp
 
-from fixplan.models.base import ConicForm, FrictionModel, soc_columns
+from fixplan.models.base import FrictionModel
+from fixplan.models.conic import ConicForm, soc_columns
 from fixplan.planner.objectives import objective_expression
 from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, PASSIVE_ROLES, Problem
 from fixplan.tolerances import MAX_SAFETY_FACTOR
