@@ -118,7 +118,7 @@ class Plan:
             else f"{_multiple(low)}–{_multiple(high)} × the task load"
         )
         if self.held.get(load_name):
-            if high - low <= HELD_RTOL * high:
+            if np.isfinite(high) and high - low <= HELD_RTOL * high:
                 return "held at the task load only, with no margin either way"
             return f"held for {span}"
         if low > 0.0:
