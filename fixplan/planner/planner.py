@@ -251,9 +251,9 @@ class Planner:
         forces = {}
         for i, contact in enumerate(self.problem.contacts):
             if contact.role == "clamp":
-                forces[contact.name] = float(normal[i, 0])
+                forces[contact.name] = max(float(normal[i, 0]), 0.0)
             elif contact.role == "finger":
-                forces[contact.name] = normal[i].copy()
+                forces[contact.name] = np.maximum(normal[i], 0.0)
         return forces
 
     def _wrenches(self, normal, friction) -> np.ndarray:

@@ -285,10 +285,12 @@ def set_given(stacked: Stacked, values: dict, cases: int) -> None:
     finger_values = None if fingers is None else np.zeros(fingers.shape)
     clamp_values = None if clamps is None else np.zeros(clamps.shape)
     for i, (kind, row) in stacked.given.items():
+        # A planned force may come back from the solver as -1e-12 N: given forces are >= 0.
+        value = np.maximum(values[i], 0.0)
         if kind == "finger":
-            finger_values[row] = np.broadcast_to(values[i], (cases,))
+            finger_values[row] = np.broadcast_to(value, (cases,))
         else:
-            clamp_values[row] = float(np.ravel(values[i])[0])
+            clamp_values[row] = float(np.ravel(value)[0])
     if fingers is not None:
         fingers.value = finger_values
     if clamps is not None:
