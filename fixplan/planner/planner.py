@@ -72,7 +72,7 @@ class Planner:
         passive_map = self.layout.normal_map[:, self._passive]
         squeezable = np.zeros(len(problem.contacts), dtype=bool)
         if not allow_squeeze:
-            squeezable[self._passive] = squeezing(passive_map)
+            squeezable[self._passive] = squeezing(passive_map, self.length_scale)
         self.squeeze_contacts = tuple(
             c.name for c, s in zip(problem.contacts, squeezable, strict=True) if s
         )
@@ -176,7 +176,7 @@ class Planner:
         for _ in range(len(passive_names)):
             if result["status"] not in ("optimal", "inaccurate"):
                 break
-            more = unload_squeezes(passive_map, result["normal"][self._passive])
+            more = unload_squeezes(passive_map, result["normal"][self._passive], self.length_scale)
             if not more.any():
                 break
             unloaded |= more

@@ -28,19 +28,25 @@ from scipy.optimize import linprog
 from fixplan.tolerances import SQUEEZE_RTOL
 
 
-def squeezing(normal_map: np.ndarray) -> np.ndarray:
+def squeezing(normal_map: np.ndarray, length_scale: float) -> np.ndarray:
     """Which contacts (columns of ``normal_map`` ``(6, P)``, passive contacts' wrenches per unit
-    normal force) belong to some squeeze: ``(P,)`` bool."""
+    normal force) take part in some squeeze: ``(P,)`` bool. ``length_scale`` [m] makes moments
+    comparable with forces."""
     count = normal_map.shape[1]
-    if count < 2:
-        return np.zeros(count, dtype=bool)
-    # The largest squeeze with every force at most 1 has the largest support: every contact
-    # that takes part in some squeeze carries force in it.
-    found = _largest_squeeze(normal_map, np.ones(count))
-    return found > SQUEEZE_RTOL
+    found = np.zeros(count, dtype=bool)
+    # Each linear program finds a squeeze that loads contacts not yet found, until none does.
+    while not found.all():
+        squeeze = _largest_squeeze(normal_map, np.ones(count), length_scale, weights=~found)
+        new = (squeeze > SQUEEZE_RTOL) & ~found
+        if not new.any():
+            break
+        found |= squeeze > SQUEEZE_RTOL
+    return found
 
 
-def unload_squeezes(normal_map: np.ndarray, passive_forces: np.ndarray) -> np.ndarray:
+def unload_squeezes(
+    normal_map: np.ndarray, passive_forces: np.ndarray, length_scale: float
+) -> np.ndarray:
     """Contacts to unload, ``(P, K)`` bool: per load case (columns of ``passive_forces``
     ``(P, K)`` [N]) the contact of the largest squeeze under the forces that the squeeze loads
     most in proportion; none where a case holds no squeeze."""
@@ -50,7 +56,7 @@ def unload_squeezes(normal_map: np.ndarray, passive_forces: np.ndarray) -> np.nd
         largest = forces.max(initial=0.0)
         if largest == 0.0:
             continue
-        squeeze = _largest_squeeze(normal_map, forces / largest)
+        squeeze = _largest_squeeze(normal_map, forces / largest, length_scale)
         if squeeze.sum() <= SQUEEZE_RTOL:
             continue
         members = np.flatnonzero(squeeze > SQUEEZE_RTOL)
@@ -58,12 +64,18 @@ def unload_squeezes(normal_map: np.ndarray, passive_forces: np.ndarray) -> np.nd
     return unload
 
 
-def _largest_squeeze(normal_map: np.ndarray, bound: np.ndarray) -> np.ndarray:
-    """The squeeze ``0 <= s <= bound`` of largest total (a linear program)."""
-    # Forces and moments in comparable units: each row scaled to unit size.
-    rows = normal_map / np.maximum(np.abs(normal_map).max(axis=1, keepdims=True), 1e-300)
+def _largest_squeeze(
+    normal_map: np.ndarray, bound: np.ndarray, length_scale: float, *, weights=None
+) -> np.ndarray:
+    """The squeeze ``0 <= s <= bound`` of largest (``weights``-weighted) total: a linear
+    program."""
+    # Moments over the body's length, so that the equality weighs them like the forces; entries
+    # of rounding size (a centre of pressure 1e-19 m off the contact point) are zero.
+    rows = normal_map / np.array([1.0, 1.0, 1.0, length_scale, length_scale, length_scale])[:, None]
+    rows = np.where(np.abs(rows) > 1e-12, rows, 0.0)
+    weights = np.ones(len(bound)) if weights is None else np.asarray(weights, dtype=float)
     result = linprog(
-        -np.ones(len(bound)), A_eq=rows, b_eq=np.zeros(6),
+        -weights, A_eq=rows, b_eq=np.zeros(6),
         bounds=list(zip(np.zeros(len(bound)), bound, strict=True)), method="highs",
     )  # fmt: skip
     if result.status != 0:  # pragma: no cover - the LP is feasible (s = 0) and bounded
