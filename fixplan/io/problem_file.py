@@ -73,8 +73,8 @@ from pathlib import Path
 import numpy as np
 
 from fixplan import validation
-from fixplan.errors import FixplanError
-from fixplan.planner.contact_models import PLANNER_EXACT_ORDER
+from fixplan.errors import FixplanError, InvalidArgumentError
+from fixplan.planner.contact_models import PLANNER_EXACT_ORDER, contact_model
 from fixplan.planner.problem import (
     AREA_MODEL_NAMES,
     MODEL_NAMES,
@@ -314,6 +314,30 @@ def _reason(exc: Exception) -> str:
     if isinstance(exc, ValueError):
         return "the path is not valid (it holds a NUL character)"
     return str(exc)
+
+
+def check_problem(path: str | os.PathLike[str], *, model: str | None = None) -> ProblemFile:
+    """Read a problem file like :func:`load_problem` and also build every contact's friction
+    model, so that every mistake of the input that planning would meet is found, without
+    solving.
+
+    Raises
+    ------
+    ProblemFileError
+        As :func:`load_problem`, or a contact's friction model cannot be built from its patch
+        (reported at the contact's key path).
+    """
+    problem_file = load_problem(path, model=model)
+    issues = []
+    for index, contact in enumerate(problem_file.problem.contacts):
+        try:
+            contact_model(contact)
+        except InvalidArgumentError as exc:
+            message = f"its friction model cannot be built: {exc}"
+            issues.append(Issue(key_path=f"contacts[{index}]", message=message))
+    if issues:
+        raise ProblemFileError(problem_file.path, issues)
+    return problem_file
 
 
 def _parse_toml(path: Path, content: bytes) -> dict:
@@ -1032,4 +1056,4 @@ def _check_unique_names(tables: list[_Table], noun: str) -> None:
             first[name] = table.path
 
 
-__all__ = ["Issue", "ProblemFile", "ProblemFileError", "load_problem"]
+__all__ = ["Issue", "ProblemFile", "ProblemFileError", "check_problem", "load_problem"]
