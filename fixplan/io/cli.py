@@ -322,7 +322,13 @@ def _run_plan(args: argparse.Namespace) -> tuple[int, str]:
     problem_file = _load(args.file, args.model)
     if args.report is not None:
         _check_output_folder(args.report, "--report")
-    planner = Planner(problem_file.problem, solver=args.solver)
+    try:
+        planner = Planner(problem_file.problem, solver=args.solver)
+    except InvalidArgumentError:
+        from fixplan.io.problem_file import check_problem
+
+        check_problem(args.file, model=args.model)  # names the file and the contact at fault
+        raise
     log.info("solving %s (%d load cases)", args.file, len(problem_file.problem.loads))
     plan = planner.solve(progress=_Progress("solving", not args.quiet))
     if args.report is not None:
