@@ -115,3 +115,10 @@ MAX_RELATIVE_VALUE = 1e12
 #: Most friction disks the planner's exact model may discretise one patch into (about five
 #: seconds of model building and solving per patch at this size).
 MAX_EXACT_POINTS = 8192
+
+#: Smallest patch dimension [m] (a nanometre): below it the limit surface's arithmetic
+#: underflows.
+MIN_PATCH_LENGTH = 1e-9
+
+#: Largest ratio of a rectangle patch's sides (the inverse map loses accuracy on needles).
+MAX_ASPECT_RATIO = 1e5

@@ -220,6 +220,7 @@ def edited(tmp_path: Path, *replacements: tuple[str, str]) -> Path:
         ('model = "ellipsoid"', 'model = "pyramid"\nfacets = 10000000', "defaults.facets",
          "from 3 to 64"),
         ('name = "thumb"', f'name = "{"t" * 250}"', "contacts[0].name", "1 to 100 characters"),
+        ("radius = 0.008", "radius = 1e-300", "contacts[0].patch.radius", "below 1e-09 m"),
     ],
 )  # fmt: skip
 def test_values_out_of_range_are_invalid_input_naming_file_key_and_range(

@@ -390,10 +390,30 @@ def _bounded(option: str, value: float | None, limit: float, unit: str) -> None:
 
 def _patch(args: argparse.Namespace):
     from fixplan.surface import pressure
-    from fixplan.tolerances import MAX_FORCE, MAX_LENGTH, MAX_MU, MIN_MU
+    from fixplan.tolerances import (
+        MAX_ASPECT_RATIO,
+        MAX_FORCE,
+        MAX_LENGTH,
+        MAX_MU,
+        MIN_MU,
+        MIN_PATCH_LENGTH,
+    )
 
     for option in ("radius", "inner_radius", "length", "width"):
-        _bounded(f"--{option.replace('_', '-')}", getattr(args, option), MAX_LENGTH, "m")
+        value = getattr(args, option)
+        _bounded(f"--{option.replace('_', '-')}", value, MAX_LENGTH, "m")
+        if value is not None and 0.0 < value < MIN_PATCH_LENGTH:
+            raise InvalidArgumentError(
+                f"--{option.replace('_', '-')} must be at least {MIN_PATCH_LENGTH:g} m, got "
+                f"{value:g}"
+            )
+    if args.shape == "rectangle" and (args.length or 0.0) > 0.0 and (args.width or 0.0) > 0.0:
+        ratio = max(args.length, args.width) / min(args.length, args.width)
+        if ratio > MAX_ASPECT_RATIO:
+            raise InvalidArgumentError(
+                f"--length and --width: the sides' ratio {ratio:.3g} exceeds the "
+                f"{MAX_ASPECT_RATIO:g} accepted"
+            )
     _bounded("--normal-force", args.normal_force, MAX_FORCE, "N")
     _bounded("--mu", args.mu, MAX_MU, "")
     if 0.0 < args.mu < MIN_MU:

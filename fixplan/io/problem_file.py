@@ -89,6 +89,7 @@ from fixplan.planner.problem import (
 from fixplan.surface import pressure
 from fixplan.tolerances import (
     MAX_ACCELERATION,
+    MAX_ASPECT_RATIO,
     MAX_EXACT_POINTS,
     MAX_FACETS,
     MAX_FORCE,
@@ -102,6 +103,7 @@ from fixplan.tolerances import (
     MAX_RELATIVE_VALUE,
     MAX_TORQUE,
     MIN_MU,
+    MIN_PATCH_LENGTH,
 )
 
 #: The version of the schema this module reads.
@@ -559,7 +561,13 @@ def _nested(
 
 _Kind = _Number | _Integer | _Boolean | _Text | _Choice | _Array
 
-_LENGTH = _Number("> 0", MAX_LENGTH, "m")
+_LENGTH = _Number(
+    "> 0",
+    MAX_LENGTH,
+    "m",
+    smallest=MIN_PATCH_LENGTH,
+    why_smallest="m (the limit surface's arithmetic underflows)",
+)
 _MASS = _Number(">= 0", MAX_MASS, "kg")
 _FORCE = _Number(">= 0", MAX_FORCE, "N")
 _MU = _Number(
@@ -957,6 +965,14 @@ def _rectangle(patch: _Table) -> Callable | None:
             f"expected 'uniform' (the only pressure of a rectangle), got {_describe(profile)}; "
             "use a grid for other pressure maps",
         )
+    if length is not None and width is not None:
+        ratio = max(length, width) / min(length, width)
+        if ratio > MAX_ASPECT_RATIO:
+            patch.report(
+                "width",
+                f"the sides' ratio {ratio:.3g} exceeds the {MAX_ASPECT_RATIO:g} accepted; model "
+                "so thin a strip as points along a line or widen it",
+            )
     return functools.partial(pressure.rectangle, length, width)
 
 
