@@ -142,11 +142,9 @@ def mutate(document: dict, rnd: random.Random) -> dict:
 
 def toml_text(document: dict) -> str:
     """``document`` as TOML, every table and array written inline."""
-    return "".join(f"{_toml_key(key)} = {_toml_value(value)}\n" for key, value in document.items())
-
-
-def _toml_key(key: str) -> str:
-    return _toml_string(key)
+    return "".join(
+        f"{_toml_string(key)} = {_toml_value(value)}\n" for key, value in document.items()
+    )
 
 
 def _toml_string(text: str) -> str:
@@ -168,7 +166,7 @@ def _toml_value(value: object) -> str:
         return value.isoformat()
     if isinstance(value, list):
         return "[" + ", ".join(_toml_value(item) for item in value) + "]"
-    items = ", ".join(f"{_toml_key(k)} = {_toml_value(v)}" for k, v in value.items())
+    items = ", ".join(f"{_toml_string(k)} = {_toml_value(v)}" for k, v in value.items())
     return "{" + items + "}"
 
 

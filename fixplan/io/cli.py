@@ -277,21 +277,20 @@ def _json(document: dict) -> str:
     return json.dumps(strict(document), indent=2, sort_keys=True, allow_nan=False)
 
 
-def _path_text(path: Path) -> str:
-    return repr(str(path)) if not str(path).isprintable() else str(path)
+def _output_path(path: Path, option: str) -> str:
+    """How messages name the output ``path`` of ``option``; rejects a path holding a NUL."""
+    text = str(path)
+    if "\x00" in text:
+        raise InvalidArgumentError(f"{option} {text!r}: not a valid path (it holds a NUL)")
+    return f"{option} {text}"
 
 
 def _check_output_folder(path: Path, option: str) -> None:
     """Fail before any work is done if ``path`` cannot become a folder of results."""
-    where = f"{option} {_path_text(path)}"
-    try:
-        if path.exists() and not path.is_dir():
-            raise InvalidArgumentError(f"{where}: a file of that name exists; name a folder")
-        ancestor = next(p for p in (path, *path.absolute().parents) if p.exists())
-    except ValueError as exc:
-        if isinstance(exc, InvalidArgumentError):
-            raise
-        raise InvalidArgumentError(f"{where}: not a valid path (it holds a NUL)") from None
+    where = _output_path(path, option)
+    if path.exists() and not path.is_dir():
+        raise InvalidArgumentError(f"{where}: a file of that name exists; name a folder")
+    ancestor = next(p for p in (path.absolute(), *path.absolute().parents) if p.exists())
     if not ancestor.is_dir():
         raise InvalidArgumentError(f"{where}: {ancestor} is a file, not a folder")
     if not os.access(ancestor, os.W_OK | os.X_OK):
@@ -300,17 +299,11 @@ def _check_output_folder(path: Path, option: str) -> None:
 
 def _check_output_file(path: Path, option: str) -> None:
     """Fail before any work is done if the file ``path`` cannot be written."""
-    where = f"{option} {_path_text(path)}"
-    try:
-        folder = path.absolute().parent
-        if path.is_dir():
-            raise InvalidArgumentError(f"{where}: a folder of that name exists; name a file")
-        exists = folder.is_dir()
-    except ValueError as exc:
-        if isinstance(exc, InvalidArgumentError):
-            raise
-        raise InvalidArgumentError(f"{where}: not a valid path (it holds a NUL)") from None
-    if not exists:
+    where = _output_path(path, option)
+    folder = path.absolute().parent
+    if path.is_dir():
+        raise InvalidArgumentError(f"{where}: a folder of that name exists; name a file")
+    if not folder.is_dir():
         raise InvalidArgumentError(f"{where}: the folder {folder} does not exist; create it first")
     if not os.access(folder, os.W_OK | os.X_OK):
         raise InvalidArgumentError(f"{where}: cannot write in {folder} (permission denied)")
