@@ -393,3 +393,15 @@ def test_help_does_not_import_the_solver_stack(command):
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
     assert "exit codes:" in result.stdout
     assert result.stderr.strip() == "[]"
+
+
+def test_a_reader_that_leaves_early_gets_no_traceback(tmp_path):
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    result = subprocess.run(
+        [sys.executable, "-m", "fixplan.io.cli", "check", str(write(tmp_path))],
+        stdout=write_end, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    os.close(write_end)
+    assert result.returncode == EXIT_OK
+    assert "Traceback" not in result.stderr

@@ -616,7 +616,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return EXIT_UNEXPECTED
-    print(output)
+    try:
+        print(output, flush=True)
+    except BrokenPipeError:
+        # The reader of stdout left early (``fixplan plan FILE | head``): drop the rest quietly.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     return code
 
 
