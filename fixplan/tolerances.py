@@ -73,3 +73,59 @@ MULTIPLE_ATOL = 1e-7
 #: Passive normal forces that squeeze each other by less than this fraction of the largest
 #: passive normal force of the load case are solver noise, not a squeeze.
 SQUEEZE_RTOL = 1e-6
+
+# -- Accepted ranges of inputs ------------------------------------------------------------------
+# Physically generous bounds, checked where values enter (problem files, Problem, the command
+# line), so that arithmetic never overflows and problem sizes stay within seconds of work.
+
+#: Largest coordinate, position or patch dimension [m] (a kilometre).
+MAX_LENGTH = 1e3
+
+#: Largest force [N] (a load, a clamp or finger force, its bound; about 100,000 t-force).
+MAX_FORCE = 1e9
+
+#: Largest torque [N m] of a load: ``MAX_FORCE`` at ``MAX_LENGTH``.
+MAX_TORQUE = MAX_FORCE * MAX_LENGTH
+
+#: Largest body mass [kg] (10,000 t).
+MAX_MASS = 1e7
+
+#: Largest gravitational acceleration [m/s²] (about 100 g).
+MAX_ACCELERATION = 1e3
+
+#: Largest friction coefficient (real ones are below about 5; a gecko pad is about 10).
+MAX_MU = 100.0
+
+#: Smallest positive friction coefficient: below it friction is numerical noise against the
+#: normal forces (give 0 for a frictionless contact where the model allows it).
+MIN_MU = 1e-6
+
+#: Most facets of a pyramid model.
+MAX_FACETS = 64
+
+#: Longest name of a contact or load case, in characters (names become report file names).
+MAX_NAME_LENGTH = 100
+
+#: Most vertices of a polygon patch (the exact model's cost grows with the square).
+MAX_POLYGON_VERTICES = 256
+
+#: Most support points of a ``points`` patch.
+MAX_POINTS = 4096
+
+#: Most cells of a ``grid`` patch (a 64 × 64 tactile array).
+MAX_GRID_CELLS = 4096
+
+#: Largest magnitude of a relative weight or pressure (points' weights, grid values): they are
+#: ratios, so any scale will do, and sums of up to ``MAX_GRID_CELLS`` of them stay finite.
+MAX_RELATIVE_VALUE = 1e12
+
+#: Most friction disks the planner's exact model may discretise one patch into (about five
+#: seconds of model building and solving per patch at this size).
+MAX_EXACT_POINTS = 8192
+
+#: Smallest patch dimension [m] (a nanometre): below it the limit surface's arithmetic
+#: underflows.
+MIN_PATCH_LENGTH = 1e-9
+
+#: Largest ratio of a rectangle patch's sides (the inverse map loses accuracy on needles).
+MAX_ASPECT_RATIO = 1e5

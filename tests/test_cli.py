@@ -1,6 +1,8 @@
 """The fixplan command line: outputs, exit codes and validation messages."""
 
 import json
+import math
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -187,3 +189,219 @@ def test_results_go_to_stdout_and_nothing_else_to_it_when_quiet(tmp_path):
     )  # fmt: skip
     json.loads(result.stdout)
     assert result.stderr == ""
+
+
+# -- what a new user trips over: every bad input ends in a clear message and exit code 2 --------
+
+
+def edited(tmp_path: Path, *replacements: tuple[str, str]) -> Path:
+    path = write(tmp_path)
+    text = path.read_text()
+    for old, new in replacements:
+        assert old in text, old
+        text = text.replace(old, new)
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "key_path", "allowed"),
+    [
+        ("position = [0.0, -0.02, 0.0]", "position = [1e308, -0.02, 0.0]", "contacts[0].position",
+         "within ±1000 m"),
+        ('force = [0.0, 0.0, -2.0]', "force = [0.0, 0.0, -1e308]", "loads[0].force",
+         "within ±1e+09 N"),
+        ("point = [0.03, 0.0, 0.0]", "point = [-1e308, 0.0, 0.0]", "loads[0].point",
+         "within ±1000 m"),
+        ("center_of_mass = [0.0, 0.0, 0.0]", "center_of_mass = [0.0, 1e308, 0.0]",
+         "body.center_of_mass", "within ±1000 m"),
+        ("mu = 0.8", "mu = 1e300", "defaults.mu", "at most 100"),
+        ("mu = 0.8", "mu = 1e-300", "defaults.mu", "below 1e-06"),
+        ('model = "ellipsoid"', 'model = "pyramid"\nfacets = 10000000', "defaults.facets",
+         "from 3 to 64"),
+        ('name = "thumb"', f'name = "{"t" * 250}"', "contacts[0].name", "1 to 100 characters"),
+        ("radius = 0.008", "radius = 1e-300", "contacts[0].patch.radius", "below 1e-09 m"),
+    ],
+)  # fmt: skip
+def test_values_out_of_range_are_invalid_input_naming_file_key_and_range(
+    tmp_path, capsys, old, new, key_path, allowed
+):
+    path = edited(tmp_path, (old, new))
+    for command in ("check", "plan"):
+        assert main([command, str(path)]) == EXIT_INVALID_INPUT
+        err = capsys.readouterr().err
+        assert f"{path}: {key_path}: " in err and allowed in err
+
+
+def test_a_polygon_with_too_many_vertices_is_invalid_input(tmp_path, capsys):
+    angles = [2 * math.pi * k / 2000 for k in range(2000)]
+    circle = [[0.01 * math.cos(a), 0.01 * math.sin(a)] for a in angles]
+    patch = f'patch = {{ shape = "polygon", vertices = {circle} }}'
+    path = edited(tmp_path, ('patch = { shape = "disk", radius = 0.008, pressure = "hertz" }',
+                             patch))  # fmt: skip
+    assert main(["check", str(path)]) == EXIT_INVALID_INPUT
+    assert "contacts[0].patch.vertices: expected at most 256 items, got 2000" in (
+        capsys.readouterr().err
+    )
+
+
+def test_the_exact_model_of_too_fine_a_patch_is_invalid_input(tmp_path, capsys):
+    x = [(k - 5.5) / 1000 for k in range(12)]
+    patch = f'patch = {{ shape = "grid", x = {x}, y = {x}, values = {[[1.0] * 12] * 12} }}'
+    path = edited(tmp_path, ('patch = { shape = "disk", radius = 0.008, pressure = "hertz" }',
+                             patch))  # fmt: skip
+    assert main(["check", str(path), "--json"]) == EXIT_OK
+    capsys.readouterr()
+    assert main(["plan", str(path), "--model", "exact"]) == EXIT_INVALID_INPUT
+    assert "contacts[0].patch: the exact model would split this patch into 9216 friction disks" in (
+        capsys.readouterr().err
+    )
+
+
+def test_a_failed_run_writes_no_report(tmp_path, capsys):
+    path = edited(tmp_path, ("position = [0.0, -0.02, 0.0]", "position = [1e308, -0.02, 0.0]"))
+    report = tmp_path / "report"
+    assert main(["plan", str(path), "--report", str(report)]) == EXIT_INVALID_INPUT
+    assert not report.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pinch.toml"]
+
+
+def test_a_report_that_fails_midway_leaves_nothing_behind(tmp_path, capsys, monkeypatch):
+    from fixplan.io import report as report_module
+
+    def broken(*args):
+        raise report_module.ReportError("cannot write: disk full")
+
+    monkeypatch.setattr(report_module, "_to_html", broken)
+    report = tmp_path / "out" / "report"
+    assert main(["plan", str(write(tmp_path)), "--report", str(report)]) == EXIT_INVALID_INPUT
+    assert "disk full" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pinch.toml"]
+
+
+def test_a_report_path_naming_a_file_is_rejected_before_solving(tmp_path, capsys, monkeypatch):
+    from fixplan.planner.planner import Planner
+
+    def never(*args, **kwargs):
+        raise AssertionError("solved before checking the report folder")
+
+    monkeypatch.setattr(Planner, "solve", never)
+    taken = tmp_path / "taken"
+    taken.write_text("a file")
+    for report in (taken, taken / "inside"):
+        assert main(["plan", str(write(tmp_path)), "--report", str(report)]) == EXIT_INVALID_INPUT
+        assert "--report" in capsys.readouterr().err
+    assert taken.read_text() == "a file"
+
+
+def test_a_deeply_nested_table_is_invalid_input(tmp_path, capsys):
+    path = edited(tmp_path, ("mass = 0.2", "mass = " + "{a = " * 400 + "1" + "}" * 400))
+    assert main(["check", str(path)]) == EXIT_INVALID_INPUT
+    assert f"{path}: tables or arrays are nested too deeply" in capsys.readouterr().err
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this platform")
+def test_a_fifo_is_rejected_without_reading_it(tmp_path, capsys):
+    fifo = tmp_path / "problem.toml"
+    os.mkfifo(fifo)
+    assert main(["check", str(fifo)]) == EXIT_INVALID_INPUT
+    assert f"{fifo}: cannot read the file: it is not a regular file" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name", ["bad\x00name.csv", "folder.csv"])
+def test_a_csv_path_that_cannot_be_read_is_invalid_input(tmp_path, capsys, name):
+    (tmp_path / "folder.csv").mkdir()
+    patch = f'patch = {{ shape = "grid", x = [0.0, 0.01], y = [0.0], values = "{name!s}" }}'
+    path = edited(
+        tmp_path,
+        ('patch = { shape = "disk", radius = 0.008, pressure = "hertz" }',
+         patch.replace("\x00", "\\u0000")),
+    )  # fmt: skip
+    assert main(["check", str(path)]) == EXIT_INVALID_INPUT
+    assert "contacts[0].patch.values: cannot read the CSV file" in capsys.readouterr().err
+
+
+def test_a_toml_file_with_a_byte_order_mark_is_read(tmp_path, capsys):
+    path = write(tmp_path)
+    path.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
+    assert main(["check", str(path)]) == EXIT_OK
+
+
+def test_check_json_is_one_document_for_valid_and_invalid_files(tmp_path, capsys):
+    path = write(tmp_path)
+    assert main(["check", str(path), "--json"]) == EXIT_OK
+    document = json.loads(capsys.readouterr().out)
+    assert document["valid"] and document["contacts"] == ["thumb", "index"]
+    path.write_text(path.read_text().replace("mu = 0.8", "mu = -1"))
+    assert main(["check", str(path), "--json"]) == EXIT_INVALID_INPUT
+    document = json.loads(capsys.readouterr().out)
+    assert not document["valid"]
+    assert document["issues"] == [
+        {"key_path": "defaults.mu", "message": "expected a number >= 0, got -1"}
+    ]
+
+
+def test_solver_output_on_file_descriptor_1_goes_to_stderr(tmp_path, capfd, monkeypatch):
+    from fixplan.planner.planner import Planner
+
+    solve = Planner.solve
+
+    def noisy(self, *args, **kwargs):
+        os.write(1, b"ERROR: a solver printed this\n")
+        return solve(self, *args, **kwargs)
+
+    monkeypatch.setattr(Planner, "solve", noisy)
+    assert main(["plan", str(write(tmp_path)), "--json", "-q"]) == EXIT_OK
+    out, err = capfd.readouterr()
+    assert json.loads(out)["status"] == "optimal"
+    assert "ERROR: a solver printed this" in err
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        (["--radius", "1e308"], "--radius must be at most 1000 m"),
+        (["--radius", "0.01", "--plot", "missing/figure.png"], "the folder"),
+    ],
+)
+def test_surface_options_out_of_range_are_invalid_input(tmp_path, capsys, monkeypatch, options,
+                                                        message):  # fmt: skip
+    monkeypatch.chdir(tmp_path)
+    assert main(["surface", "--shape", "disk", "--mu", "0.5", *options]) == EXIT_INVALID_INPUT
+    assert message in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("command", [[sys.executable, "-m", "fixplan.io.cli"], ["fixplan"]])
+def test_help_does_not_import_the_solver_stack(command):
+    script = (
+        "import runpy, sys; sys.argv = ['fixplan', '--help']\n"
+        "try:\n"
+        "    runpy.run_module('fixplan.io.cli', run_name='__main__')\n"
+        "except SystemExit:\n"
+        "    pass\n"
+        "heavy = sorted({m.split('.')[0] for m in sys.modules} & {'numpy', 'cvxpy', 'scipy', "
+        "'numba', 'matplotlib'})\n"
+        "print(heavy, file=sys.stderr)\n"
+    )
+    if command == ["fixplan"]:
+        script = script.replace(
+            "runpy.run_module('fixplan.io.cli', run_name='__main__')",
+            "from importlib.metadata import entry_points\n"
+            "    entry_points(group='console_scripts')['fixplan'].load()()",
+        )
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert "exit codes:" in result.stdout
+    assert result.stderr.strip() == "[]"
+
+
+def test_a_reader_that_leaves_early_gets_no_traceback(tmp_path):
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    result = subprocess.run(
+        [sys.executable, "-m", "fixplan.io.cli", "check", str(write(tmp_path))],
+        stdout=write_end, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    os.close(write_end)
+    assert result.returncode == EXIT_OK
+    assert "Traceback" not in result.stderr

@@ -8,20 +8,25 @@ load case whose safety factor is below 1), 4 solver failure or inaccurate result
 from __future__ import annotations
 
 import argparse
+import contextlib
+import ctypes
+import functools
+import importlib
 import json
 import logging
+import math
+import os
 import sys
 import time
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
-
-import numpy as np
 
 from fixplan import __version__
 from fixplan.errors import ConvergenceError, FixplanError, InvalidArgumentError
-from fixplan.planner.problem import MODEL_NAMES
-from fixplan.surface import pressure
+
+# Only the standard library is imported up to here: ``fixplan --help`` and ``--version`` stay
+# fast (numpy, cvxpy and the planner are imported by the subcommands that use them).
 
 EXIT_OK = 0
 EXIT_UNEXPECTED = 1
@@ -49,6 +54,29 @@ part under every task load, the safety margin of a given setup, and how it would
 {EXIT_CODES}"""
 
 log = logging.getLogger("fixplan")
+
+
+class _Names(Sequence):
+    """A tuple of names defined in a fixplan module, imported when argparse first reads it (to
+    check a value or show a subcommand's help), so that building the parser imports nothing."""
+
+    def __init__(self, module: str, attribute: str):
+        self.module = module
+        self.attribute = attribute
+
+    @functools.cached_property
+    def names(self) -> tuple[str, ...]:
+        return tuple(getattr(importlib.import_module(self.module), self.attribute))
+
+    def __getitem__(self, index):
+        return self.names[index]
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+
+_MODEL_NAMES = _Names("fixplan.planner.problem", "MODEL_NAMES")
+_DISK_PROFILES = _Names("fixplan.surface.pressure", "DISK_PROFILES")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -86,8 +114,10 @@ def _build_parser() -> argparse.ArgumentParser:
     plan.add_argument("--report", type=Path, metavar="DIR", help="write a report folder")
     plan.add_argument(
         "--model",
-        choices=MODEL_NAMES,
-        help="override every contact's model (contacts without a patch get its point version)",
+        choices=_MODEL_NAMES,
+        metavar="MODEL",
+        help="override every contact's model (contacts without a patch get its point version): "
+        "%(choices)s",
     )
     plan.add_argument("--solver", choices=("CLARABEL", "OSQP", "SCS"), help="conic/QP solver")
     _verbosity(plan)
@@ -98,6 +128,7 @@ def _build_parser() -> argparse.ArgumentParser:
         "fixplan check problems/fixture-321.toml",
     )  # fmt: skip
     check.add_argument("file", type=Path, help="problem file (TOML)")
+    check.add_argument("--json", action="store_true", help="print one JSON document")
     _verbosity(check)
     check.set_defaults(run=_run_check)
 
@@ -111,7 +142,11 @@ def _build_parser() -> argparse.ArgumentParser:
     surface.add_argument("--length", type=float, help="rectangle length along x [m]")
     surface.add_argument("--width", type=float, help="rectangle width along y [m]")
     surface.add_argument(
-        "--pressure", default="uniform", choices=pressure.DISK_PROFILES, help="disk profile"
+        "--pressure",
+        default="uniform",
+        choices=_DISK_PROFILES,
+        metavar="PROFILE",
+        help="disk profile: %(choices)s (default %(default)s)",
     )
     surface.add_argument("--mu", type=float, required=True, help="friction coefficient")
     surface.add_argument("--normal-force", type=float, default=1.0, help="normal force [N]")
@@ -174,7 +209,7 @@ def _exit_code(plan) -> int:
 def _number(value: float, unit: str = "") -> str:
     if value is None:
         return "-"
-    if not np.isfinite(value):
+    if not math.isfinite(value):
         return "inf" if value > 0 else str(value)
     return f"{value:.4g}{(' ' + unit) if unit else ''}"
 
@@ -195,11 +230,11 @@ def _summary(problem_file, plan) -> str:
     if plan.forces:
         lines.append("active forces")
         for name, force in plan.forces.items():
-            if np.ndim(force) == 0:
+            if isinstance(force, float):
                 lines.append(f"  {name:24s} {_number(force, 'N'):>12s}  (clamp)")
             else:
                 lines.append(
-                    f"  {name:24s} {_number(float(np.max(force)), 'N'):>12s}  (finger, largest "
+                    f"  {name:24s} {_number(float(max(force)), 'N'):>12s}  (finger, largest "
                     "over the load cases)"
                 )
     if plan.safety_factors:
@@ -226,11 +261,67 @@ def _load(file: Path, model: str | None = None):
     return load_problem(file, model=model)
 
 
-def _run_plan(args: argparse.Namespace) -> int:
+def _json(document: dict) -> str:
+    """``document`` as strict JSON: infinities and NaN become the strings ``"inf"``, ``"-inf"``
+    and ``"nan"`` (as in :meth:`Plan.as_dict`)."""
+
+    def strict(value):
+        if isinstance(value, float) and not math.isfinite(value):
+            return "nan" if math.isnan(value) else "inf" if value > 0 else "-inf"
+        if isinstance(value, dict):
+            return {key: strict(item) for key, item in value.items()}
+        if isinstance(value, list | tuple):
+            return [strict(item) for item in value]
+        return value
+
+    return json.dumps(strict(document), indent=2, sort_keys=True, allow_nan=False)
+
+
+def _output_path(path: Path, option: str) -> str:
+    """How messages name the output ``path`` of ``option``; rejects a path holding a NUL."""
+    text = str(path)
+    if "\x00" in text:
+        raise InvalidArgumentError(f"{option} {text!r}: not a valid path (it holds a NUL)")
+    return f"{option} {text}"
+
+
+def _check_output_folder(path: Path, option: str) -> None:
+    """Fail before any work is done if ``path`` cannot become a folder of results."""
+    where = _output_path(path, option)
+    if path.exists() and not path.is_dir():
+        raise InvalidArgumentError(f"{where}: a file of that name exists; name a folder")
+    ancestor = next(p for p in (path.absolute(), *path.absolute().parents) if p.exists())
+    if not ancestor.is_dir():
+        raise InvalidArgumentError(f"{where}: {ancestor} is a file, not a folder")
+    if not os.access(ancestor, os.W_OK | os.X_OK):
+        raise InvalidArgumentError(f"{where}: cannot write in {ancestor} (permission denied)")
+
+
+def _check_output_file(path: Path, option: str) -> None:
+    """Fail before any work is done if the file ``path`` cannot be written."""
+    where = _output_path(path, option)
+    folder = path.absolute().parent
+    if path.is_dir():
+        raise InvalidArgumentError(f"{where}: a folder of that name exists; name a file")
+    if not folder.is_dir():
+        raise InvalidArgumentError(f"{where}: the folder {folder} does not exist; create it first")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise InvalidArgumentError(f"{where}: cannot write in {folder} (permission denied)")
+
+
+def _run_plan(args: argparse.Namespace) -> tuple[int, str]:
     from fixplan.planner.planner import Planner
 
     problem_file = _load(args.file, args.model)
-    planner = Planner(problem_file.problem, solver=args.solver)
+    if args.report is not None:
+        _check_output_folder(args.report, "--report")
+    try:
+        planner = Planner(problem_file.problem, solver=args.solver)
+    except InvalidArgumentError:
+        from fixplan.io.problem_file import check_problem
+
+        check_problem(args.file, model=args.model)  # names the file and the contact at fault
+        raise
     log.info("solving %s (%d load cases)", args.file, len(problem_file.problem.loads))
     plan = planner.solve(progress=_Progress("solving", not args.quiet))
     if args.report is not None:
@@ -242,29 +333,87 @@ def _run_plan(args: argparse.Namespace) -> int:
         document = plan.as_dict()
         document["problem"] = {"name": problem_file.name, "file": str(problem_file.path),
                                "sha256": problem_file.sha256}  # fmt: skip
-        print(json.dumps(document, indent=2, sort_keys=True))
-    else:
-        print(_summary(problem_file, plan))
-    return _exit_code(plan)
+        return _exit_code(plan), _json(document)
+    return _exit_code(plan), _summary(problem_file, plan)
 
 
 # -- check ---------------------------------------------------------------------------------------
 
 
-def _run_check(args: argparse.Namespace) -> int:
-    problem_file = _load(args.file)
+def _run_check(args: argparse.Namespace) -> tuple[int, str]:
+    from fixplan.io.problem_file import ProblemFileError, check_problem
+
+    try:
+        problem_file = check_problem(args.file)
+    except ProblemFileError as exc:
+        if not args.json:
+            raise
+        print(f"fixplan: error: {exc}", file=sys.stderr)
+        issues = [{"key_path": i.key_path, "message": i.message} for i in exc.issues]
+        document = {"file": str(args.file), "valid": False, "issues": issues}
+        return EXIT_INVALID_INPUT, _json(document)
     problem = problem_file.problem
-    print(
+    if args.json:
+        document = {
+            "file": str(args.file),
+            "valid": True,
+            "issues": [],
+            "name": problem_file.name,
+            "kind": problem_file.kind,
+            "objective": problem.objective,
+            "contacts": [contact.name for contact in problem.contacts],
+            "loads": [load.name for load in problem.loads],
+            "sha256": problem_file.sha256,
+        }
+        return EXIT_OK, _json(document)
+    return EXIT_OK, (
         f"{args.file}: valid — {problem_file.name} ({problem_file.kind}), objective "
         f"{problem.objective}, {len(problem.contacts)} contacts, {len(problem.loads)} load cases"
     )
-    return EXIT_OK
 
 
 # -- surface -------------------------------------------------------------------------------------
 
 
-def _patch(args: argparse.Namespace) -> pressure.PressureField:
+def _bounded(option: str, value: float | None, limit: float, unit: str) -> None:
+    """Reject an option value above ``limit`` (the range the library accepts is checked by it)."""
+    if value is not None and math.isfinite(value) and abs(value) > limit:
+        raise InvalidArgumentError(f"{option} must be at most {limit:g} {unit}, got {value:g}")
+
+
+def _patch(args: argparse.Namespace):
+    from fixplan.surface import pressure
+    from fixplan.tolerances import (
+        MAX_ASPECT_RATIO,
+        MAX_FORCE,
+        MAX_LENGTH,
+        MAX_MU,
+        MIN_MU,
+        MIN_PATCH_LENGTH,
+    )
+
+    for option in ("radius", "inner_radius", "length", "width"):
+        value = getattr(args, option)
+        _bounded(f"--{option.replace('_', '-')}", value, MAX_LENGTH, "m")
+        if value is not None and 0.0 < value < MIN_PATCH_LENGTH:
+            raise InvalidArgumentError(
+                f"--{option.replace('_', '-')} must be at least {MIN_PATCH_LENGTH:g} m, got "
+                f"{value:g}"
+            )
+    if args.shape == "rectangle" and (args.length or 0.0) > 0.0 and (args.width or 0.0) > 0.0:
+        ratio = max(args.length, args.width) / min(args.length, args.width)
+        if ratio > MAX_ASPECT_RATIO:
+            raise InvalidArgumentError(
+                f"--length and --width: the sides' ratio {ratio:.3g} exceeds the "
+                f"{MAX_ASPECT_RATIO:g} accepted"
+            )
+    _bounded("--normal-force", args.normal_force, MAX_FORCE, "N")
+    _bounded("--mu", args.mu, MAX_MU, "")
+    if 0.0 < args.mu < MIN_MU:
+        raise InvalidArgumentError(
+            f"--mu must be at least {MIN_MU:g} (friction that small is rounding noise), got "
+            f"{args.mu:g}"
+        )
     if args.shape == "disk":
         if args.radius is None:
             raise InvalidArgumentError("--shape disk needs --radius [m]")
@@ -293,20 +442,26 @@ def _surface_models(surface):
 
 def _percent(fraction: float) -> float:
     """``fraction`` in percent rounded to 0.01, without a negative zero."""
-    return float(np.round(100.0 * fraction, 2)) + 0.0
+    return round(100.0 * fraction, 2) + 0.0
 
 
-def _run_surface(args: argparse.Namespace) -> int:
+def _run_surface(args: argparse.Namespace) -> tuple[int, str]:
     from fixplan.models.compare import compare
     from fixplan.surface.limit_surface import LimitSurface
 
-    surface = LimitSurface(_patch(args), mu=args.mu, normal_force=args.normal_force)
+    patch = _patch(args)
+    if args.plot is not None:
+        _check_output_file(args.plot, "--plot")
+    surface = LimitSurface(patch, mu=args.mu, normal_force=args.normal_force)
     models = _surface_models(surface)
     accuracy = {name: compare(model, surface, n=1000) for name, model in models.items()}
     if args.plot is not None:
         from fixplan.io.figures import save_png, surface_figure
 
-        save_png(surface_figure(surface, models), args.plot)
+        try:
+            save_png(surface_figure(surface, models), args.plot)
+        except OSError as exc:
+            raise InvalidArgumentError(f"--plot {args.plot}: cannot write it: {exc}") from exc
         log.info("wrote %s", args.plot)
     summary = {
         "shape": args.shape,
@@ -328,26 +483,34 @@ def _run_surface(args: argparse.Namespace) -> int:
         },
     }
     if args.json:
-        print(json.dumps(summary, indent=2, sort_keys=True))
-        return EXIT_OK
-    print(f"limit surface of a {args.shape} patch ({args.pressure} pressure)")
-    print(f"  mu = {args.mu:g}, normal force = {args.normal_force:g} N")
-    print(f"  max friction force     {surface.max_force:12.6g} N")
-    print(f"  max friction moment    {surface.max_moment:12.6g} N m")
-    print(f"  characteristic length  {surface.characteristic_length:12.6g} m")
-    if surface.frictionless:
-        print("  frictionless: the limit surface is the load 0; the errors below are those of")
-        print("  the shapes (mu = 1), the same at any mu > 0")
-    print("model errors against the exact surface (radial, over 1000 load directions;")
-    print("  over = model holds more than the contact: unsafe)")
-    print(f"  {'model':24s} {'max over':>9s} {'max under':>10s} {'unsafe':>7s} {'motion':>9s}")
+        return EXIT_OK, _json(summary)
+    lines = [
+        f"limit surface of a {args.shape} patch ({args.pressure} pressure)",
+        f"  mu = {args.mu:g}, normal force = {args.normal_force:g} N",
+        f"  max friction force     {surface.max_force:12.6g} N",
+        f"  max friction moment    {surface.max_moment:12.6g} N m",
+        f"  characteristic length  {surface.characteristic_length:12.6g} m",
+        *(
+            [
+                "  frictionless: the limit surface is the load 0; the errors below are those of",
+                "  the shapes (mu = 1), the same at any mu > 0",
+            ]
+            if surface.frictionless
+            else []
+        ),
+        "model errors against the exact surface (radial, over 1000 load directions;",
+        "  over = model holds more than the contact: unsafe)",
+        f"  {'model':24s} {'max over':>9s} {'max under':>10s} {'unsafe':>7s} {'motion':>9s}",
+    ]
     for name, acc in accuracy.items():
-        angle = "-" if acc.max_motion_angle is None else f"{np.degrees(acc.max_motion_angle):.2f}°"
+        angle = (
+            "-" if acc.max_motion_angle is None else f"{math.degrees(acc.max_motion_angle):.2f}°"
+        )
         over, under = (_percent(acc.max_overestimate), _percent(acc.max_underestimate))
-        print(
+        lines.append(
             f"  {name:24s} {over:8.2f}% {under:9.2f}% {100 * acc.unsafe_fraction:6.1f}% {angle:>9s}"
         )
-    return EXIT_OK
+    return EXIT_OK, "\n".join(lines)
 
 
 # -- compare -------------------------------------------------------------------------------------
@@ -362,20 +525,21 @@ def _compare_models(problem) -> list[str]:
     return point_models
 
 
-def _run_compare(args: argparse.Namespace) -> int:
+def _run_compare(args: argparse.Namespace) -> tuple[int, str]:
     from fixplan.planner.planner import Planner
 
     base = _load(args.file)
     models = _compare_models(base.problem)
+    problem_files = {model: _load(args.file, model) for model in models}
     progress = _Progress("models", not args.quiet)
     rows = []
-    for index, model in enumerate(models):
-        problem_file = _load(args.file, model)
+    for index, (model, problem_file) in enumerate(problem_files.items()):
         start = time.perf_counter()
         plan = Planner(problem_file.problem, solver=args.solver).solve()
         elapsed = time.perf_counter() - start
         rows.append((model, plan, elapsed))
         progress(index + 1, len(models))
+    code = max(_exit_code(plan) for _, plan, _ in rows)
     if args.json:
         document = {
             model: {
@@ -387,19 +551,48 @@ def _run_compare(args: argparse.Namespace) -> int:
             }
             for model, plan, elapsed in rows
         }
-        print(json.dumps(document, indent=2, sort_keys=True))
-    else:
-        print(
-            f"{base.name}: objective {base.problem.objective}, every contact with one model "
-            "(contacts without a patch with its point version)"
+        return code, _json(document)
+    lines = [
+        f"{base.name}: objective {base.problem.objective}, every contact with one model "
+        "(contacts without a patch with its point version)",
+        f"  {'model':14s} {'status':11s} {'value':>12s} {'min safety':>11s} {'time':>8s}",
+    ]
+    for model, plan, elapsed in rows:
+        lines.append(
+            f"  {model:14s} {plan.status:11s} {_number(plan.objective_value):>12s} "
+            f"{_number(plan.safety_factor):>11s} {elapsed:7.2f}s"
         )
-        print(f"  {'model':14s} {'status':11s} {'value':>12s} {'min safety':>11s} {'time':>8s}")
-        for model, plan, elapsed in rows:
-            print(
-                f"  {model:14s} {plan.status:11s} {_number(plan.objective_value):>12s} "
-                f"{_number(plan.safety_factor):>11s} {elapsed:7.2f}s"
-            )
-    return max(_exit_code(plan) for _, plan, _ in rows)
+    return code, "\n".join(lines)
+
+
+@contextlib.contextmanager
+def _stdout_to_stderr() -> Iterator[None]:
+    """Send everything written to file descriptor 1 to stderr meanwhile.
+
+    Solvers print from compiled code straight to the process's stdout (SCS prints ``ERROR:
+    ...`` even when told to be quiet); stdout must carry only the results. Where file
+    descriptors cannot be duplicated (an embedding without a real stdout), nothing changes.
+    """
+    sys.stdout.flush()
+    try:
+        saved = os.dup(1)
+        os.dup2(2, 1)
+    except (OSError, ValueError):
+        yield
+        return
+    try:
+        yield
+    finally:
+        sys.stdout.flush()
+        _flush_c_streams()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def _flush_c_streams() -> None:
+    """Flush the C library's output buffers (text a solver printed but did not flush yet)."""
+    with contextlib.suppress(OSError, AttributeError, TypeError):  # no C library found
+        ctypes.CDLL(None).fflush(None)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -409,17 +602,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     level = logging.ERROR if args.quiet else logging.DEBUG if args.verbose else logging.WARNING
     logging.basicConfig(level=level, format="fixplan: %(message)s", stream=sys.stderr)
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), _stdout_to_stderr():
             warnings.simplefilter("ignore" if args.quiet else "default")
+            import numpy as np
+
             with np.errstate(all="ignore"):
-                return args.run(args)
+                code, output = args.run(args)
     except ConvergenceError as exc:
         print(f"fixplan: numerical failure: {exc}", file=sys.stderr)
         return EXIT_SOLVER
     except FixplanError as exc:
         print(f"fixplan: error: {exc}", file=sys.stderr)
-        # Errors about the input derive from ValueError; any other is fixplan's own failure.
-        return EXIT_INVALID_INPUT if isinstance(exc, ValueError) else EXIT_UNEXPECTED
+        # Errors about the input or the outputs asked for (a folder that cannot be written)
+        # derive from ValueError or OSError; any other is fixplan's own failure.
+        return EXIT_INVALID_INPUT if isinstance(exc, ValueError | OSError) else EXIT_UNEXPECTED
     except KeyboardInterrupt:  # pragma: no cover
         return EXIT_UNEXPECTED
     except Exception as exc:
@@ -429,6 +625,12 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return EXIT_UNEXPECTED
+    try:
+        print(output, flush=True)
+    except BrokenPipeError:
+        # The reader of stdout left early (``fixplan plan FILE | head``): drop the rest quietly.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    return code
 
 
 if __name__ == "__main__":  # pragma: no cover

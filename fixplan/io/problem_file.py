@@ -64,6 +64,7 @@ import math
 import os
 import re
 import reprlib
+import stat
 import tomllib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -73,7 +74,8 @@ from pathlib import Path
 import numpy as np
 
 from fixplan import validation
-from fixplan.errors import FixplanError
+from fixplan.errors import FixplanError, InvalidArgumentError
+from fixplan.planner.contact_models import PLANNER_EXACT_ORDER, contact_model
 from fixplan.planner.problem import (
     AREA_MODEL_NAMES,
     MODEL_NAMES,
@@ -86,6 +88,24 @@ from fixplan.planner.problem import (
     Problem,
 )
 from fixplan.surface import pressure
+from fixplan.tolerances import (
+    MAX_ACCELERATION,
+    MAX_ASPECT_RATIO,
+    MAX_EXACT_POINTS,
+    MAX_FACETS,
+    MAX_FORCE,
+    MAX_GRID_CELLS,
+    MAX_LENGTH,
+    MAX_MASS,
+    MAX_MU,
+    MAX_NAME_LENGTH,
+    MAX_POINTS,
+    MAX_POLYGON_VERTICES,
+    MAX_RELATIVE_VALUE,
+    MAX_TORQUE,
+    MIN_MU,
+    MIN_PATCH_LENGTH,
+)
 
 #: The version of the schema this module reads.
 SCHEMA_VERSION = 1
@@ -99,6 +119,9 @@ POINT_VERSION = {
     "cone": "point-cone",
     "pyramid": "point-pyramid",
 }
+
+#: Largest problem file, and largest CSV file of a grid patch, read [bytes].
+MAX_FILE_BYTES = 10_000_000
 
 #: A contact normal in a file must have length 1 within this absolute tolerance (a guard against
 #: typos; the value is normalised exactly when the contact is built).
@@ -246,11 +269,10 @@ def load_problem(path: str | os.PathLike[str], *, model: str | None = None) -> P
     if model is not None:
         model = validation.choice("model", model, MODEL_NAMES)
     try:
-        content = path.read_bytes()
-    except OSError as exc:
-        raise ProblemFileError(
-            path, [Issue(key_path="", message=f"cannot read the file: {exc.strerror or exc}")]
-        ) from exc
+        content = _read_regular_file(path, MAX_FILE_BYTES)
+    except _InvalidValueError as exc:
+        message = f"cannot read the file: {exc}"
+        raise ProblemFileError(path, [Issue(key_path="", message=message)]) from None
     document = _parse_toml(path, content)
     reader = _Reader(folder=path.parent, model=model)
     name, kind, problem = reader.document(document)
@@ -266,15 +288,74 @@ def load_problem(path: str | os.PathLike[str], *, model: str | None = None) -> P
     )
 
 
-def _parse_toml(path: Path, content: bytes) -> dict:
+def _read_regular_file(path: Path, limit: int) -> bytes:
+    """The bytes of the regular file ``path`` of at most ``limit`` bytes; the error's message
+    says why it cannot be read.
+
+    The file type is checked before the file is opened: reading a FIFO or a device would block
+    or never end.
+    """
     try:
-        return tomllib.loads(content.decode("utf-8"))
+        status = path.stat()
+    except (OSError, ValueError) as exc:
+        raise _InvalidValueError(_reason(exc)) from None
+    if not stat.S_ISREG(status.st_mode):
+        kind = "a folder" if stat.S_ISDIR(status.st_mode) else "not a regular file"
+        raise _InvalidValueError(f"it is {kind}")
+    if status.st_size > limit:
+        raise _InvalidValueError(f"it has {status.st_size} bytes, more than the {limit} accepted")
+    try:
+        return path.read_bytes()
+    except OSError as exc:
+        raise _InvalidValueError(_reason(exc)) from None
+
+
+def _reason(exc: Exception) -> str:
+    """Why a file operation failed, without the path (the message names it already)."""
+    if isinstance(exc, OSError) and exc.strerror:
+        return exc.strerror
+    if isinstance(exc, ValueError):
+        return "the path is not valid (it holds a NUL character)"
+    return str(exc)
+
+
+def check_problem(path: str | os.PathLike[str], *, model: str | None = None) -> ProblemFile:
+    """Read a problem file like :func:`load_problem` and also build every contact's friction
+    model, so that every mistake of the input that planning would meet is found, without
+    solving.
+
+    Raises
+    ------
+    ProblemFileError
+        As :func:`load_problem`, or a contact's friction model cannot be built from its patch
+        (reported at the contact's key path).
+    """
+    problem_file = load_problem(path, model=model)
+    issues = []
+    for index, contact in enumerate(problem_file.problem.contacts):
+        try:
+            contact_model(contact)
+        except InvalidArgumentError as exc:
+            message = f"its friction model cannot be built: {exc}"
+            issues.append(Issue(key_path=f"contacts[{index}]", message=message))
+    if issues:
+        raise ProblemFileError(problem_file.path, issues)
+    return problem_file
+
+
+def _parse_toml(path: Path, content: bytes) -> dict:
+    """The TOML document of ``content``; a leading UTF-8 byte-order mark is ignored."""
+    try:
+        return tomllib.loads(content.decode("utf-8-sig"))
     except UnicodeDecodeError as exc:
         message = f"not UTF-8 text (byte {exc.start} cannot be decoded); save it as UTF-8"
         raise ProblemFileError(path, [Issue(key_path="", message=message)]) from exc
     except tomllib.TOMLDecodeError as exc:
         message = f"TOML syntax error: {exc}"
         raise ProblemFileError(path, [Issue(key_path="", message=message)]) from exc
+    except RecursionError:
+        message = "tables or arrays are nested too deeply to read (hundreds of levels)"
+        raise ProblemFileError(path, [Issue(key_path="", message=message)]) from None
 
 
 class _InvalidValueError(Exception):
@@ -321,26 +402,47 @@ def _finite(value: object) -> float:
 
 @dataclass(frozen=True, slots=True)
 class _Number:
-    """A finite number, optionally bounded below (``bound`` is ``"> 0"`` or ``">= 0"``)."""
+    """A finite number, optionally bounded below (``bound`` is ``"> 0"`` or ``">= 0"``) and in
+    size (``limit``, in ``unit``); positive values below ``smallest`` are rejected with
+    ``why_smallest``."""
 
     bound: str = ""
+    limit: float | None = None
+    unit: str = ""
+    smallest: float | None = None
+    why_smallest: str = ""
 
     @property
     def expected(self) -> str:
         return f"a number {self.bound}".rstrip()
 
+    @property
+    def accepted_range(self) -> str:
+        unit = f" {self.unit}" if self.unit else ""
+        if self.bound:
+            return f"a number {self.bound} and at most {self.limit:g}{unit}"
+        return f"a number within ±{self.limit:g}{unit}"
+
     def __call__(self, value: object) -> float:
         number = _finite(value)
         if (self.bound == "> 0" and number <= 0.0) or (self.bound == ">= 0" and number < 0.0):
             raise _InvalidValueError(f"expected {self.expected}, got {value}")
+        if self.limit is not None and abs(number) > self.limit:
+            raise _InvalidValueError(f"expected {self.accepted_range}, got {value}")
+        if self.smallest is not None and 0.0 < number < self.smallest:
+            raise _InvalidValueError(
+                f"expected {self.accepted_range}, got {value}: below {self.smallest:g} "
+                f"{self.why_smallest}"
+            )
         return number
 
 
 @dataclass(frozen=True, slots=True)
 class _Integer:
-    """An integer >= ``minimum``."""
+    """An integer from ``minimum`` to ``maximum``."""
 
     minimum: int
+    maximum: int
 
     @property
     def expected(self) -> str:
@@ -349,6 +451,10 @@ class _Integer:
     def __call__(self, value: object) -> int:
         if isinstance(value, bool) or not isinstance(value, int) or value < self.minimum:
             raise _InvalidValueError(f"expected {self.expected}, got {_describe(value)}")
+        if value > self.maximum:
+            raise _InvalidValueError(
+                f"expected an integer from {self.minimum} to {self.maximum}, got {value}"
+            )
         return value
 
 
@@ -364,11 +470,25 @@ class _Boolean:
 
 @dataclass(frozen=True, slots=True)
 class _Text:
-    expected: str = "a non-empty string"
+    """A non-empty string; a name (``name=True``) has at most ``MAX_NAME_LENGTH`` characters
+    and no control characters (names become headings and file names of reports)."""
+
+    name: bool = False
+
+    @property
+    def expected(self) -> str:
+        if self.name:
+            return f"a name of 1 to {MAX_NAME_LENGTH} characters without control characters"
+        return "a non-empty string"
 
     def __call__(self, value: object) -> str:
-        if not isinstance(value, str) or not value.strip():
-            raise _InvalidValueError(f"expected {self.expected}, got {_describe(value)}")
+        if (
+            not isinstance(value, str)
+            or not value.strip()
+            or (self.name and (len(value) > MAX_NAME_LENGTH or not value.isprintable()))
+        ):
+            got = f"{len(value)} characters" if isinstance(value, str) and len(value) > 40 else ""
+            raise _InvalidValueError(f"expected {self.expected}, got {got or _describe(value)}")
         return value
 
 
@@ -392,19 +512,27 @@ class _Choice:
 
 @dataclass(frozen=True, slots=True)
 class _Array:
-    """Nested non-empty arrays of finite numbers of ``shape`` (``None``: any length)."""
+    """Nested non-empty arrays of ``shape`` (``None``: any length, up to ``max_items`` in the
+    first dimension) of numbers of the kind ``element``."""
 
     shape: tuple[int | None, ...]
+    element: _Number = _Number()
+    max_items: int | None = None
 
     @property
     def expected(self) -> str:
-        return _shape_text(self.shape)
+        text = _shape_text(self.shape)
+        return f"{text}, at most {self.max_items} of them" if self.max_items else text
 
     def __call__(self, value: object) -> list:
-        return _nested(value, self.shape, "")
+        if self.max_items is not None and isinstance(value, list) and len(value) > self.max_items:
+            raise _InvalidValueError(f"expected at most {self.max_items} items, got {len(value)}")
+        return _nested(value, self.shape, self.element, "")
 
 
 def _shape_text(shape: tuple[int | None, ...], *, plural: bool = False) -> str:
+    """The structure of nested arrays in words (the elements' range is told where one is out
+    of it)."""
     if not shape:
         return "numbers" if plural else "a number"
     count = "" if shape[0] is None else f"{shape[0]} "
@@ -412,11 +540,13 @@ def _shape_text(shape: tuple[int | None, ...], *, plural: bool = False) -> str:
     return f"{head} of {count}{_shape_text(shape[1:], plural=True)}"
 
 
-def _nested(value: object, shape: tuple[int | None, ...], index: str) -> list | float:
+def _nested(
+    value: object, shape: tuple[int | None, ...], element: _Number, index: str
+) -> list | float:
     where = f"element {index}: " if index else ""
     if not shape:
         try:
-            return _finite(value)
+            return element(value)
         except _InvalidValueError as exc:
             raise _InvalidValueError(f"{where}{exc}") from None
     expected = _shape_text(shape)
@@ -427,21 +557,43 @@ def _nested(value: object, shape: tuple[int | None, ...], index: str) -> list | 
     if shape[0] is not None and len(value) != shape[0]:
         items = "item" if len(value) == 1 else "items"
         raise _InvalidValueError(f"{where}expected {expected}, got {len(value)} {items}")
-    return [_nested(item, shape[1:], f"{index}[{i}]") for i, item in enumerate(value)]
+    return [_nested(item, shape[1:], element, f"{index}[{i}]") for i, item in enumerate(value)]
 
 
 _Kind = _Number | _Integer | _Boolean | _Text | _Choice | _Array
 
-_POSITIVE = _Number("> 0")
-_NONNEGATIVE = _Number(">= 0")
+_LENGTH = _Number(
+    "> 0",
+    MAX_LENGTH,
+    "m",
+    smallest=MIN_PATCH_LENGTH,
+    why_smallest="m (the limit surface's arithmetic underflows)",
+)
+_MASS = _Number(">= 0", MAX_MASS, "kg")
+_FORCE = _Number(">= 0", MAX_FORCE, "N")
+_MU = _Number(
+    ">= 0",
+    MAX_MU,
+    smallest=MIN_MU,
+    why_smallest="(friction that small is rounding noise against the forces; give 0 for a "
+    "frictionless contact)",
+)
 _TEXT = _Text()
+_NAME = _Text(name=True)
 _BOOLEAN = _Boolean()
-_FACETS = _Integer(3)
+_FACETS = _Integer(3, MAX_FACETS)
 _MODEL = _Choice(MODEL_NAMES)
-_VECTOR = _Array((3,))
-_NUMBERS = _Array((None,))
-_PAIRS = _Array((None, 2))
-_ROWS = _Array((None, None))
+_POSITION = _Array((3,), _Number("", MAX_LENGTH, "m"))
+_FORCE_VECTOR = _Array((3,), _Number("", MAX_FORCE, "N"))
+_TORQUE_VECTOR = _Array((3,), _Number("", MAX_TORQUE, "N m"))
+_GRAVITY = _Array((3,), _Number("", MAX_ACCELERATION, "m/s^2"))
+_DIRECTION = _Array((3,))
+_COORDINATES = _Array((None,), _Number("", MAX_LENGTH, "m"), MAX_GRID_CELLS)
+_RELATIVE = _Number("", MAX_RELATIVE_VALUE)
+_WEIGHTS = _Array((None,), _RELATIVE, MAX_POINTS)
+_VERTICES = _Array((None, 2), _Number("", MAX_LENGTH, "m"), MAX_POLYGON_VERTICES)
+_POINTS = _Array((None, 2), _Number("", MAX_LENGTH, "m"), MAX_POINTS)
+_ROWS = _Array((None, None), _RELATIVE, MAX_GRID_CELLS)
 
 
 @dataclass(slots=True)
@@ -484,7 +636,7 @@ class _Table:
 
     def direction(self, key: str, *, required: bool = False) -> list[float] | None:
         """A nonzero 3-vector at ``key``."""
-        vector = self.get(key, _VECTOR, required=required)
+        vector = self.get(key, _DIRECTION, required=required)
         if vector is not None and not any(vector):
             self.report(key, "expected a direction, got the zero vector")
             return None
@@ -550,7 +702,7 @@ class _Reader:
         top = _Table(data, "", self.issues)
         top.check_keys(_TOP_KEYS)
         _check_schema_version(top)
-        name = top.get("name", _TEXT, required=True)
+        name = top.get("name", _NAME, required=True)
         kind = top.get("kind", _Choice(KINDS), required=True)
         objective = top.get("objective", _Choice(OBJECTIVES), required=True)
         if "description" in data and not isinstance(data["description"], str):
@@ -581,7 +733,7 @@ class _Reader:
         if table is None:
             return _Defaults()
         table.check_keys(_DEFAULT_KEYS)
-        kinds = {"mu": _NONNEGATIVE, "model": _MODEL, "facets": _FACETS, "inscribed": _BOOLEAN}
+        kinds = {"mu": _MU, "model": _MODEL, "facets": _FACETS, "inscribed": _BOOLEAN}
         values = {key: table.get(key, kind) for key, kind in kinds.items()}
         return _Defaults(
             values={key: value for key, value in values.items() if value is not None},
@@ -593,9 +745,9 @@ class _Reader:
             return None
         start = len(self.issues)
         table.check_keys(_BODY_KEYS)
-        mass = table.get("mass", _NONNEGATIVE, required=True)
-        center = table.get("center_of_mass", _VECTOR, required=True)
-        gravity = table.get("gravity", _VECTOR)
+        mass = table.get("mass", _MASS, required=True)
+        center = table.get("center_of_mass", _POSITION, required=True)
+        gravity = table.get("gravity", _GRAVITY)
         if len(self.issues) > start:
             return None
         return _build(table, Body, mass=mass, center_of_mass=center, **_given(gravity=gravity))
@@ -603,10 +755,10 @@ class _Reader:
     def _load(self, table: _Table) -> Load | None:
         start = len(self.issues)
         table.check_keys(_LOAD_KEYS)
-        name = table.get("name", _TEXT, required=True)
-        force = table.get("force", _VECTOR, required=True)
-        point = table.get("point", _VECTOR, required=True)
-        torque = table.get("torque", _VECTOR)
+        name = table.get("name", _NAME, required=True)
+        force = table.get("force", _FORCE_VECTOR, required=True)
+        point = table.get("point", _POSITION, required=True)
+        torque = table.get("torque", _TORQUE_VECTOR)
         if len(self.issues) > start:
             return None
         return _build(table, Load, name=name, force=force, point=point, **_given(torque=torque))
@@ -614,11 +766,11 @@ class _Reader:
     def _contact(self, table: _Table, defaults: _Defaults) -> Contact | None:
         start = len(self.issues)
         table.check_keys(_CONTACT_KEYS)
-        name = table.get("name", _TEXT, required=True)
+        name = table.get("name", _NAME, required=True)
         role = table.get("role", _Choice(ROLES), required=True)
-        position = table.get("position", _VECTOR, required=True)
+        position = table.get("position", _POSITION, required=True)
         normal = _normal(table)
-        mu = _with_default(table, "mu", _NONNEGATIVE, defaults, required=True)
+        mu = _with_default(table, "mu", _MU, defaults, required=True)
         file_model = _with_default(table, "model", _MODEL, defaults, required=self.model is None)
         model = self.model or file_model
         if self.model in AREA_MODEL_NAMES and "patch" not in table.data:
@@ -626,6 +778,8 @@ class _Reader:
         facets = self._pyramid_option(table, "facets", _FACETS, defaults, model)
         inscribed = self._pyramid_option(table, "inscribed", _BOOLEAN, defaults, model)
         patch, patch_axis = self._patch(table)
+        if model == "exact" and patch is not None:
+            _check_exact_size(table, patch)
         if model in AREA_MODEL_NAMES and "patch" not in table.data:
             self._report_missing_patch(table, model, name)
         axis = _contact_axis(table, patch_axis)
@@ -711,6 +865,19 @@ def _build(table: _Table, constructor: Callable, *, key: str | None = None, **ar
         return None
 
 
+def _check_exact_size(table: _Table, patch: pressure.PressureField) -> None:
+    """Report a patch too fine for the planner's exact model (its cost grows with the number
+    of friction disks)."""
+    disks = len(patch.quadrature(PLANNER_EXACT_ORDER)[0])
+    if disks > MAX_EXACT_POINTS:
+        table.report(
+            "patch",
+            f"the exact model would split this patch into {disks} friction disks, more than "
+            f"the {MAX_EXACT_POINTS} accepted; give fewer vertices, points or grid cells, or "
+            "use another model",
+        )
+
+
 def _check_schema_version(top: _Table) -> None:
     version = top.data.get("schema_version")
     if version is None:
@@ -776,13 +943,13 @@ def _active_force(table: _Table, key: str, role: str | None) -> float | None:
             "it, or make the role 'clamp' or 'finger')",
         )
         return None
-    return table.get(key, _NONNEGATIVE)
+    return table.get(key, _FORCE)
 
 
 def _disk(patch: _Table) -> Callable | None:
-    radius = patch.get("radius", _POSITIVE, required=True)
+    radius = patch.get("radius", _LENGTH, required=True)
     profile = patch.get("pressure", _Choice(pressure.DISK_PROFILES), default="uniform")
-    inner = patch.get("inner_radius", _POSITIVE)
+    inner = patch.get("inner_radius", _LENGTH)
     if profile == "annulus" and "inner_radius" not in patch.data:
         patch.report("inner_radius", "missing: pressure 'annulus' needs inner_radius < radius [m]")
     elif profile not in (None, "annulus") and "inner_radius" in patch.data:
@@ -791,8 +958,8 @@ def _disk(patch: _Table) -> Callable | None:
 
 
 def _rectangle(patch: _Table) -> Callable | None:
-    length = patch.get("length", _POSITIVE, required=True)
-    width = patch.get("width", _POSITIVE, required=True)
+    length = patch.get("length", _LENGTH, required=True)
+    width = patch.get("width", _LENGTH, required=True)
     profile = patch.data.get("pressure", "uniform")
     if profile != "uniform":
         patch.report(
@@ -800,23 +967,31 @@ def _rectangle(patch: _Table) -> Callable | None:
             f"expected 'uniform' (the only pressure of a rectangle), got {_describe(profile)}; "
             "use a grid for other pressure maps",
         )
+    if length is not None and width is not None:
+        ratio = max(length, width) / min(length, width)
+        if ratio > MAX_ASPECT_RATIO:
+            patch.report(
+                "width",
+                f"the sides' ratio {ratio:.3g} exceeds the {MAX_ASPECT_RATIO:g} accepted; model "
+                "so thin a strip as points along a line or widen it",
+            )
     return functools.partial(pressure.rectangle, length, width)
 
 
 def _polygon(patch: _Table) -> Callable | None:
-    vertices = patch.get("vertices", _PAIRS, required=True)
+    vertices = patch.get("vertices", _VERTICES, required=True)
     return functools.partial(pressure.polygon, vertices)
 
 
 def _points(patch: _Table) -> Callable | None:
-    xy = patch.get("xy", _PAIRS, required=True)
-    weights = patch.get("weights", _NUMBERS)
+    xy = patch.get("xy", _POINTS, required=True)
+    weights = patch.get("weights", _WEIGHTS)
     return functools.partial(pressure.points, xy, weights)
 
 
 def _grid(patch: _Table, *, folder: Path) -> Callable | None:
-    x = patch.get("x", _NUMBERS, required=True)
-    y = patch.get("y", _NUMBERS, required=True)
+    x = patch.get("x", _COORDINATES, required=True)
+    y = patch.get("y", _COORDINATES, required=True)
     values = patch.data.get("values")
     try:
         if isinstance(values, str):
@@ -837,6 +1012,10 @@ def _grid(patch: _Table, *, folder: Path) -> Callable | None:
 
 
 def _check_grid_shape(rows: list[list[float]], nx: int, ny: int) -> None:
+    if nx * ny > MAX_GRID_CELLS:
+        raise _InvalidValueError(
+            f"a grid of {nx} by {ny} cells; at most {MAX_GRID_CELLS} cells are accepted"
+        )
     if len(rows) != ny:
         raise _InvalidValueError(f"expected {ny} rows (one per y), got {len(rows)}")
     for index, row in enumerate(rows):
@@ -853,12 +1032,13 @@ def _csv_rows(file: Path) -> list[list[float]]:
     array software often writes, are ignored.
     """
     try:
-        text = file.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror or str(exc) if isinstance(exc, OSError) else "not UTF-8 text"
-        raise _InvalidValueError(f"cannot read the CSV file {str(file)!r}: {reason}") from None
+        text = _read_regular_file(file, MAX_FILE_BYTES).decode("utf-8-sig")
+    except (_InvalidValueError, UnicodeDecodeError) as exc:
+        reason = str(exc) if isinstance(exc, _InvalidValueError) else "not UTF-8 text"
+        name = _SHORT.repr(str(file))
+        raise _InvalidValueError(f"cannot read the CSV file {name}: {reason}") from None
     rows = []
-    reader = csv.reader(text.splitlines())
+    reader = csv.reader(text.replace("\0", "\ufffd").splitlines())
     for row in reader:
         if not any(cell.strip() for cell in row):
             continue
@@ -866,13 +1046,15 @@ def _csv_rows(file: Path) -> list[list[float]]:
             row = row[:-1]
         numbers = []
         for column, cell in enumerate(row, start=1):
+            where = f"{file.name} line {reader.line_num}, column {column}"
             try:
-                numbers.append(_finite(float(cell)))
-            except (ValueError, _InvalidValueError):
+                numbers.append(_RELATIVE(float(cell)))
+            except ValueError:
                 raise _InvalidValueError(
-                    f"{file.name} line {reader.line_num}, column {column}: expected a finite "
-                    f"number, got {cell.strip()!r}"
+                    f"{where}: expected a finite number, got {_SHORT.repr(cell.strip())}"
                 ) from None
+            except _InvalidValueError as exc:
+                raise _InvalidValueError(f"{where}: {exc}") from None
         rows.append(numbers)
     if not rows:
         raise _InvalidValueError(f"{file.name} holds no numbers")
@@ -892,4 +1074,4 @@ def _check_unique_names(tables: list[_Table], noun: str) -> None:
             first[name] = table.path
 
 
-__all__ = ["Issue", "ProblemFile", "ProblemFileError", "load_problem"]
+__all__ = ["Issue", "ProblemFile", "ProblemFileError", "check_problem", "load_problem"]

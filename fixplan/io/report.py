@@ -17,12 +17,15 @@ so two reports of the same problem file and plan are byte-identical and diff cle
 
 from __future__ import annotations
 
+import contextlib
 import html
 import json
 import os
 import re
+import shutil
+import uuid
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
@@ -47,6 +50,9 @@ CONTACT_SET_POINTS = 72
 #: Printed contact forces and moments below this fraction of the largest normal force of their
 #: load case (moments: times the planner's length scale) are solver rounding and printed as 0.
 PRINT_RTOL = 1e-9
+#: Longest part of a figure's file name taken from a contact name (the contact's index keeps
+#: the names unique).
+SLUG_LENGTH = 40
 #: Equilibrium residuals below this are printed as ``below RESIDUAL_FLOOR`` (their digits are
 #: rounding noise that differs between machines).
 RESIDUAL_FLOOR = 1e-12
@@ -224,7 +230,10 @@ def _residual(value: float | None) -> str:
 
 
 def _slug(name: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_-]+", "-", name).strip("-") or "contact"
+    """A file-name part made of ``name``: ASCII letters, digits, ``_`` and ``-``, at most
+    :data:`SLUG_LENGTH` characters."""
+    slug = re.sub(r"[^A-Za-z0-9_-]+", "-", name).strip("-")[:SLUG_LENGTH].strip("-")
+    return slug or "contact"
 
 
 def _package_version(package: str) -> str:
@@ -557,8 +566,10 @@ def write_report(
     """Write the report of ``plan`` into ``directory`` (see the module docstring).
 
     The folder is created if needed; the report's own files are overwritten and any other file
-    in it is left alone. Figures that need contact forces are skipped for a plan without them
-    (infeasible, solver error), and the report says so.
+    in it is left alone. The files are written into a temporary folder beside it and moved into
+    place only when all are written: a report that fails leaves nothing behind. Figures that
+    need contact forces are skipped for a plan without them (infeasible, solver error), and the
+    report says so.
 
     Parameters
     ----------
@@ -596,11 +607,41 @@ def write_report(
             f"{', '.join(COMPONENTS)}; got {list(subspace)}"
         )
     directory = Path(directory)
+    with _staging(directory) as staging:
+        writer = _Writer(staging)
+        _write_files(writer, problem_file, plan, planner, subspace)
+    return [directory / path.name for path in writer.written]
+
+
+@contextlib.contextmanager
+def _staging(directory: Path) -> Iterator[Path]:
+    """A temporary folder for the files of the report folder ``directory``; on success its
+    files are moved there (the folder is created), on failure it is removed."""
+    if directory.is_file():
+        raise ReportError(f"cannot write the report folder {directory}: a file has its name")
     try:
-        directory.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
+        parent = next(p for p in directory.absolute().parents if p.exists())
+        staging = parent / f".{directory.name[:40]}.partial-{uuid.uuid4().hex[:12]}"
+        staging.mkdir()
+    except (OSError, ValueError) as exc:
         raise ReportError(f"cannot create the report folder {directory}: {exc}") from exc
-    writer = _Writer(directory)
+    try:
+        yield staging
+        if directory.is_dir():
+            for path in staging.iterdir():
+                os.replace(path, directory / path.name)
+        else:
+            directory.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(staging, directory)
+    except OSError as exc:
+        raise ReportError(f"cannot write the report folder {directory}: {exc}") from exc
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+
+
+def _write_files(writer: _Writer, problem_file: ProblemFile, plan: Plan, planner, subspace):
+    """Write every file of the report (see the module docstring) with ``writer``."""
+    problem = planner.problem
     document = json.dumps(plan.as_dict(), indent=2, sort_keys=True)
     writer.write("plan.json", (document + "\n").encode("utf-8"))
     load, case_note = _figure_case(plan)
@@ -617,4 +658,3 @@ def write_report(
     title = f"fixplan report: {problem_file.name}"
     writer.write("report.md", _to_markdown(blocks).encode("utf-8"))
     writer.write("report.html", _to_html(blocks, title).encode("utf-8"))
-    return writer.written

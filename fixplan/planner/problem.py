@@ -15,6 +15,17 @@ import numpy as np
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError
 from fixplan.surface.pressure import PressureField
+from fixplan.tolerances import (
+    MAX_ACCELERATION,
+    MAX_FACETS,
+    MAX_FORCE,
+    MAX_LENGTH,
+    MAX_MASS,
+    MAX_MU,
+    MAX_NAME_LENGTH,
+    MAX_TORQUE,
+    MIN_MU,
+)
 
 ROLES = ("locator", "support", "clamp", "finger")
 PASSIVE_ROLES = ("locator", "support")
@@ -42,31 +53,62 @@ class ProblemError(InvalidArgumentError):
     """A problem description is invalid; the message names the item and field."""
 
 
-def _vector(where: str, value: object, *, unit: bool = False) -> np.ndarray:
+def _vector(
+    where: str, value: object, *, unit: bool = False, limit: float | None = None, units: str = ""
+) -> np.ndarray:
+    """A finite 3-vector; a unit vector along it (``unit``), or one whose components are at
+    most ``limit`` (in ``units``) in size."""
     try:
         array = validation.finite_array(where, value, shape=(3,))
     except InvalidArgumentError as exc:
         raise ProblemError(str(exc)) from None
+    if limit is not None and np.abs(array).max() > limit:
+        raise ProblemError(
+            f"{where} must have components within ±{limit:g} {units}, got {array.tolist()}"
+        )
     if unit:
-        length = float(np.linalg.norm(array))
-        if length == 0.0:
+        largest = float(np.abs(array).max())
+        if largest == 0.0:
             raise ProblemError(f"{where} must be a nonzero direction, got {array.tolist()}")
-        array = array / length
+        array = array / largest  # no overflow in the norm of huge components
+        array = array / np.linalg.norm(array)
         array.setflags(write=False)
     return array
 
 
-def _scalar(where: str, value: object, *, positive: bool = False) -> float:
+def _scalar(
+    where: str, value: object, *, positive: bool = False, limit: float, units: str = ""
+) -> float:
+    """A finite number >= 0 (> 0 if ``positive``) and at most ``limit`` (in ``units``)."""
     try:
         check = validation.positive_scalar if positive else validation.nonnegative_scalar
-        return check(where, value)
+        number = check(where, value)
     except InvalidArgumentError as exc:
         raise ProblemError(str(exc)) from None
+    if number > limit:
+        raise ProblemError(f"{where} must be at most {limit:g} {units}, got {number!r}".rstrip())
+    return number
+
+
+def _mu(where: str, value: object) -> float:
+    """A friction coefficient: 0 (frictionless) or from ``MIN_MU`` to ``MAX_MU``."""
+    mu = _scalar(where, value, limit=MAX_MU)
+    if 0.0 < mu < MIN_MU:
+        raise ProblemError(
+            f"{where} must be 0 (frictionless) or at least {MIN_MU:g} (friction that small is "
+            f"rounding noise against the forces), got {mu!r}"
+        )
+    return mu
 
 
 def _name(where: str, value: object) -> str:
     if not isinstance(value, str) or not value.strip():
         raise ProblemError(f"{where} must be a non-empty string, got {value!r}")
+    if len(value) > MAX_NAME_LENGTH or not value.isprintable():
+        raise ProblemError(
+            f"{where} must have at most {MAX_NAME_LENGTH} characters and no control "
+            f"characters, got {len(value)} characters: {value[:40]!r}"
+        )
     return value
 
 
@@ -97,11 +139,12 @@ class Body:
     gravity: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, -9.81]))
 
     def __post_init__(self):
-        object.__setattr__(self, "mass", _scalar("body.mass", self.mass))
-        object.__setattr__(
-            self, "center_of_mass", _vector("body.center_of_mass", self.center_of_mass)
-        )
-        object.__setattr__(self, "gravity", _vector("body.gravity", self.gravity))
+        mass = _scalar("body.mass", self.mass, limit=MAX_MASS, units="kg")
+        center = _vector("body.center_of_mass", self.center_of_mass, limit=MAX_LENGTH, units="m")
+        gravity = _vector("body.gravity", self.gravity, limit=MAX_ACCELERATION, units="m/s²")
+        object.__setattr__(self, "mass", mass)
+        object.__setattr__(self, "center_of_mass", center)
+        object.__setattr__(self, "gravity", gravity)
 
     @property
     def weight_wrench(self) -> np.ndarray:
@@ -122,9 +165,12 @@ class Load:
     def __post_init__(self):
         where = f"load {self.name!r}" if isinstance(self.name, str) else "load"
         _name(f"{where}.name", self.name)
-        object.__setattr__(self, "force", _vector(f"{where}.force", self.force))
-        object.__setattr__(self, "point", _vector(f"{where}.point", self.point))
-        object.__setattr__(self, "torque", _vector(f"{where}.torque", self.torque))
+        force = _vector(f"{where}.force", self.force, limit=MAX_FORCE, units="N")
+        point = _vector(f"{where}.point", self.point, limit=MAX_LENGTH, units="m")
+        torque = _vector(f"{where}.torque", self.torque, limit=MAX_TORQUE, units="N m")
+        object.__setattr__(self, "force", force)
+        object.__setattr__(self, "point", point)
+        object.__setattr__(self, "torque", torque)
 
     @property
     def wrench(self) -> np.ndarray:
@@ -188,14 +234,15 @@ class Contact:
         _name(f"{where}.name", self.name)
         if self.role not in ROLES:
             raise ProblemError(f"{where}.role must be one of {', '.join(ROLES)}; got {self.role!r}")
-        object.__setattr__(self, "position", _vector(f"{where}.position", self.position))
+        position = _vector(f"{where}.position", self.position, limit=MAX_LENGTH, units="m")
+        object.__setattr__(self, "position", position)
         object.__setattr__(self, "normal", _vector(f"{where}.normal", self.normal, unit=True))
-        object.__setattr__(self, "mu", _scalar(f"{where}.mu", self.mu))
+        object.__setattr__(self, "mu", _mu(f"{where}.mu", self.mu))
         if self.patch is not None and not isinstance(self.patch, PressureField):
             raise ProblemError(f"{where}.patch must be a pressure field, got {self.patch!r}")
         self._check_model(where)
         if self.axis is not None:
-            axis = _vector(f"{where}.axis", self.axis)
+            axis = _vector(f"{where}.axis", self.axis, unit=True)
             tangent = axis - (axis @ self.normal) * self.normal
             if np.linalg.norm(tangent) <= 1e-9 * np.linalg.norm(axis):
                 raise ProblemError(f"{where}.axis must not be parallel to the normal")
@@ -208,7 +255,8 @@ class Contact:
                         f"{where}.{key} is only for active contacts (clamp, finger); a "
                         f"{self.role}'s normal force is a reaction"
                     )
-                object.__setattr__(self, key, _scalar(f"{where}.{key}", value))
+                force = _scalar(f"{where}.{key}", value, limit=MAX_FORCE, units="N")
+                object.__setattr__(self, key, force)
         if self.force is not None and self.max_force is not None and self.force > self.max_force:
             raise ProblemError(f"{where}.force {self.force} exceeds max_force {self.max_force}")
 
@@ -240,9 +288,13 @@ class Contact:
             raise ProblemError(f"{where}.facets and .inscribed are only for pyramid models")
         facets = self.facets
         if facets is not None and (
-            isinstance(facets, bool) or not isinstance(facets, int | np.integer) or facets < 3
+            isinstance(facets, bool)
+            or not isinstance(facets, int | np.integer)
+            or not 3 <= facets <= MAX_FACETS
         ):
-            raise ProblemError(f"{where}.facets must be an integer >= 3, got {facets!r}")
+            raise ProblemError(
+                f"{where}.facets must be an integer from 3 to {MAX_FACETS}, got {facets!r}"
+            )
         if self.inscribed is not None and not isinstance(self.inscribed, bool | np.bool_):
             raise ProblemError(f"{where}.inscribed must be true or false, got {self.inscribed!r}")
 

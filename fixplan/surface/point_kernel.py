@@ -6,9 +6,13 @@ quadrature rules of continuous fields, and for the far field of polygons.
 
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import sys
 import types
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -20,7 +24,7 @@ from fixplan.surface.kernels import SupportKernel
 #: (one point of the facet) instead of a unit force in the direction of rounding noise.
 STATIONARY_RTOL = 1e-12
 
-_JIT = {"cache": True, "fastmath": {"reassoc", "contract"}, "nogil": True}
+_JIT = {"fastmath": {"reassoc", "contract"}, "nogil": True}
 
 
 def _evaluate(px, py, pw, eps2, twists, out_h, out_loads):  # pragma: no cover - compiled
@@ -106,8 +110,54 @@ def _newton_terms(px, py, pw, eps2, twists, out_h, out_g, out_hess):  # pragma: 
 PARALLEL_MIN_WORK = 200_000
 
 
+def user_cache_dir() -> Path:
+    """The per-user folder of fixplan's compiled kernels.
+
+    ``NUMBA_CACHE_DIR`` when it is set; otherwise ``fixplan/numba`` in the platform's cache
+    folder (``$XDG_CACHE_HOME`` or ``~/.cache`` on Linux, ``~/Library/Caches`` on macOS,
+    ``%LOCALAPPDATA%`` on Windows).
+    """
+    if numba.config.CACHE_DIR:
+        return Path(numba.config.CACHE_DIR)
+    if sys.platform == "win32":
+        base = os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local"
+    elif sys.platform == "darwin":
+        base = Path.home() / "Library" / "Caches"
+    else:
+        base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "fixplan" / "numba"
+
+
+def _writable_cache_dir() -> Path | None:
+    """:func:`user_cache_dir`, created if needed; ``None`` if it cannot be written."""
+    folder = user_cache_dir()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        return None
+    return folder if os.access(folder, os.W_OK) else None
+
+
+@contextlib.contextmanager
+def _cached_in(folder: Path | None):
+    """Kernels decorated in this block cache their machine code in ``folder`` (if not ``None``).
+
+    numba's default puts the cache next to the module: inside an installed package it outlives
+    ``pip uninstall``, and the leftover folder then shadows a later (editable) install as a
+    namespace package. numba picks the cache folder when a function is decorated, so setting
+    its ``CACHE_DIR`` only meanwhile leaves other numba users alone.
+    """
+    previous = numba.config.CACHE_DIR
+    numba.config.CACHE_DIR = previous if folder is None else os.fspath(folder)
+    try:
+        yield
+    finally:
+        numba.config.CACHE_DIR = previous
+
+
 def _compiled(function):
-    """A function compiled twice: (serial, parallel).
+    """A function compiled twice: (serial, parallel), cached in :func:`user_cache_dir` (not
+    cached at all when that folder cannot be written).
 
     The serial variant is compiled from a renamed copy: numba's on-disk cache is keyed by the
     function's name, and two variants of one function would load each other's machine code.
@@ -116,7 +166,13 @@ def _compiled(function):
         function.__code__, function.__globals__, f"{function.__name__}_serial"
     )
     serial.__qualname__ = f"{function.__qualname__}_serial"
-    return numba.njit(parallel=False, **_JIT)(serial), numba.njit(parallel=True, **_JIT)(function)
+    folder = _writable_cache_dir()
+    options = {**_JIT, "cache": folder is not None}
+    with _cached_in(folder):
+        return (
+            numba.njit(parallel=False, **options)(serial),
+            numba.njit(parallel=True, **options)(function),
+        )
 
 
 _EVALUATE = _compiled(_evaluate)

@@ -1,0 +1,55 @@
+"""The README tells the truth: its commands are what CI runs, its problem-file sample is a
+complete valid problem, and its example error is what ``fixplan check`` prints."""
+
+import re
+from pathlib import Path
+
+from fixplan.io.cli import EXIT_INVALID_INPUT, EXIT_OK, main
+from fixplan.io.problem_file import load_problem
+
+ROOT = Path(__file__).resolve().parents[1]
+README = (ROOT / "README.md").read_text(encoding="utf-8")
+
+
+def _section(title: str) -> str:
+    start = README.index(f"## {title}\n")
+    end = README.find("\n## ", start + 1)
+    return README[start:end]
+
+
+def _blocks(text: str, language: str) -> list[str]:
+    return re.findall(rf"```{language}\n(.*?)```", text, flags=re.DOTALL)
+
+
+def test_ci_runs_the_two_quick_start_commands_verbatim_in_order():
+    commands = [block.strip() for block in _blocks(_section("Quick start"), "sh")]
+    assert len(commands) == 2
+    script = (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()
+    assert [line for line in script if line in commands] == commands
+
+
+def test_the_problem_file_sample_loads_and_plans(tmp_path, capsys):
+    (sample,) = _blocks(_section("Problem files"), "toml")
+    path = tmp_path / "vise.toml"
+    path.write_text(sample, encoding="utf-8")
+    problem_file = load_problem(path)
+    assert problem_file.name == "vise-milling"
+    assert main(["plan", str(path)]) == EXIT_OK
+    assert "status     optimal" in capsys.readouterr().out
+
+
+def test_the_example_error_is_what_check_prints(tmp_path, capsys, monkeypatch):
+    section = _section("Problem files")
+    (sample,) = _blocks(section, "toml")
+    mistakes = (
+        ('role = "locator"', 'frction = 0.25\nrole = "locator"'),
+        ('role = "clamp"', 'modle = "exact"\nrole = "clamp"'),
+        ("force = [120.0, -40.0, -60.0]", "force = [120.0, -40.0, -6e10]"),
+    )
+    for old, new in mistakes:
+        sample = sample.replace(old, new, 1)
+    (tmp_path / "vise.toml").write_text(sample, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    assert main(["check", "vise.toml"]) == EXIT_INVALID_INPUT
+    (documented,) = _blocks(section, "text")
+    assert capsys.readouterr().err == documented
