@@ -22,11 +22,14 @@ from fixplan.planner.stacking import ContactLayout, Stacked, build, set_given
 
 SOLVERS = ("CLARABEL", "OSQP", "SCS")
 
-#: Above this many scalar variables problems are compiled without DPP. With DPP the first solve
-#: costs more and every re-solve less: on the plate fixture of benchmarks/bench_scaling.py,
-#: 50 x 100 (19k variables) 0.56 s then 0.26 s against 0.28 s each without; 200 x 100 (75k)
-#: 3.6 s then 2.1 s against 2.4 s. Large problems are mostly solved once, so there DPP does not pay.
-DPP_MAX_VARIABLES = 20_000
+#: Problems whose scalar variables times parameter entries exceed this are compiled without
+#: DPP. cvxpy's DPP compilation builds a map from every parameter entry to the problem data, and
+#: its cost grows with that product: with DPP the first solve costs more and every re-solve less.
+#: On the plate fixture of benchmarks/bench_scaling.py: 200 contacts x 20 cases (15k variables,
+#: 127 parameter entries) 0.25 s then 0.13 s against 0.26 s and 0.15 s without; 50 x 100 (19k,
+#: 607) 0.56 s then 0.27 s against 0.28 s each; 8 x 500 (16k, 3k) peaks at 1.1-2.0 GB. Large
+#: problems are mostly solved once, so there DPP does not pay.
+DPP_MAX_WORK = 5_000_000
 
 #: Load cases per compiled problem of the fixed-force objectives (their cases are independent).
 CASES_PER_BLOCK = 64
@@ -176,7 +179,7 @@ class Runner:
             return
         if objective in self._direct or stacked.problem.status != cp.OPTIMAL:
             return
-        if stacked.problem.size_metrics.num_scalar_variables > DPP_MAX_VARIABLES:
+        if not _uses_dpp(stacked.problem):
             return
         self._solves[objective] = self._solves.get(objective, 0) + 1
         if self._solves[objective] >= 2:
@@ -193,10 +196,14 @@ def _values(stacked: Stacked) -> dict:
     }
 
 
+def _uses_dpp(problem: cp.Problem) -> bool:
+    """Whether ``problem`` is small enough for DPP to pay (see ``DPP_MAX_WORK``)."""
+    entries = sum(parameter.size for parameter in problem.parameters())
+    return problem.size_metrics.num_scalar_variables * max(entries, 1) <= DPP_MAX_WORK
+
+
 def _call(problem: cp.Problem, solver: str, *, accurate: bool = False) -> str:
-    # cvxpy's DPP compilation grows faster than the problem: past DPP_MAX_VARIABLES
-    # canonicalising afresh is quicker than compiling the parameter map.
-    large = problem.size_metrics.num_scalar_variables > DPP_MAX_VARIABLES
+    large = not _uses_dpp(problem)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
