@@ -53,3 +53,10 @@ def test_the_example_error_is_what_check_prints(tmp_path, capsys, monkeypatch):
     assert main(["check", "vise.toml"]) == EXIT_INVALID_INPUT
     (documented,) = _blocks(section, "text")
     assert capsys.readouterr().err == documented
+
+
+def test_the_quick_start_output_is_what_plan_prints(capsys, monkeypatch):
+    (documented,) = _blocks(_section("Quick start"), "text")
+    monkeypatch.chdir(ROOT)
+    assert main(["plan", "problems/vise-milling.toml"]) == EXIT_OK
+    assert capsys.readouterr().out == documented

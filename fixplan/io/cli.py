@@ -238,11 +238,12 @@ def _summary(problem_file, plan) -> str:
                     "over the load cases)"
                 )
     if plan.safety_factors:
-        lines.append("safety factors (multiple of each task load still held)")
+        lines.append("safety factors (largest multiple of each task load held)")
         for name, value in plan.safety_factors.items():
-            mark = "held" if plan.held.get(name) else "NOT HELD"
+            words = plan.describe_held(name)
+            words = words if plan.held.get(name) else words.replace("not held", "NOT HELD", 1)
             critical = "  <- critical" if name == plan.critical_load else ""
-            lines.append(f"  {name:24s} {_number(value):>12s}  {mark}{critical}")
+            lines.append(f"  {name:24s} {_number(value):>12s}  {words}{critical}")
     if plan.critical_load is not None:
         lines.append(f"critical   load {plan.critical_load!r}, contact {plan.critical_contact!r}")
         motion = plan.motions.get(plan.critical_load)

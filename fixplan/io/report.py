@@ -479,7 +479,12 @@ def _result(plan: Plan, problem: Problem) -> list[_Block]:
         ]
     if plan.safety_factors:
         rows = tuple(
-            (_text(name), _text(_num(s)), _text("yes" if plan.held.get(name) else "no"))
+            (
+                _text(name),
+                _text(_num(s)),
+                _text("yes" if plan.held.get(name) else "no"),
+                _text(plan.describe_held(name)),
+            )
             for name, s in plan.safety_factors.items()
         )
         blocks += [
@@ -487,10 +492,12 @@ def _result(plan: Plan, problem: Problem) -> list[_Block]:
             _Paragraph(
                 _text(
                     "The largest factor by which each task load (not gravity) can be scaled "
-                    "while the contacts hold it with these active forces."
+                    "while the contacts hold it with these active forces, and the interval of "
+                    "multiples held: it starts above 0 where the active forces and the weight "
+                    "alone push the part out."
                 )
             ),
-            _Table(("load case", "safety factor", "held"), rows),
+            _Table(("load case", "safety factor", "held", "multiples held"), rows),
             _Paragraph(
                 _text(
                     f"Critical load case: {plan.critical_load}; its most used contact: "

@@ -126,7 +126,7 @@ class Plan:
                 "not held even without the task load: the active forces themselves push the "
                 f"part out (held only for {span})"
             )
-        return f"not held: slides above {_multiple(high)} × the task load (held for {span})"
+        return f"not held: slides above {_multiple(high)} × the task load"
 
     def as_dict(self) -> dict:
         """JSON-ready description of the plan."""
