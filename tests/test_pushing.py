@@ -243,3 +243,32 @@ def test_a_frictionless_support_and_a_model_without_motion_are_refused():
         push_step(frictionless, contact=[-0.05, 0], normal=[1, 0], velocity=[1, 0], mu=0.3)
     with pytest.raises(InvalidArgumentError, match="normal"):
         push_step(DISK, contact=[-0.05, 0], normal=[0, 0], velocity=[1, 0], mu=0.3)
+
+
+@pytest.mark.parametrize(
+    ("contact", "normal", "velocity", "pivot"),
+    [
+        ([-0.0356, -0.0285], [0.0295, -0.9996], [0.677, -0.496], 0),
+        ([-0.0502, 0.0426], [0.9998, -0.0219], [0.375, -0.179], 2),
+        ([-0.0401, -0.0267], [-0.7607, 0.6491], [0.132, 0.494], 0),
+    ],
+)
+def test_a_part_on_support_points_can_pivot_about_one_of_them(contact, normal, velocity, pivot):
+    # The twist lands on a facet of the surface: the part turns about support point `pivot`,
+    # which carries any friction force up to its share mu N / 3 (the subgradient of h there);
+    # the others slide and carry mu N / 3 along their sliding directions.
+    surface = LimitSurface(pressure.points(THREE_POINTS), mu=MU, normal_force=NORMAL_FORCE)
+    step = push_step(surface, contact=contact, normal=normal, velocity=velocity, mu=0.5)
+    points, share = np.array(THREE_POINTS), MU * NORMAL_FORCE / 3.0
+    centre = np.array([-step.twist[1], step.twist[0]]) / step.twist[2]
+    np.testing.assert_allclose(centre, points[pivot], atol=1e-12)
+    load = step.load.copy()
+    for k, x in enumerate(points):
+        if k != pivot:
+            v = jacobian(x) @ step.twist
+            load -= share * jacobian(x).T @ (v / np.linalg.norm(v))
+    held = np.linalg.lstsq(jacobian(points[pivot]).T, load, rcond=None)[0]
+    np.testing.assert_allclose(jacobian(points[pivot]).T @ held, load, atol=1e-9 * share)
+    assert np.linalg.norm(held) <= share * (1 + 1e-9)
+    n = np.asarray(normal) / np.linalg.norm(normal)
+    assert n @ jacobian(contact) @ step.twist == pytest.approx(n @ velocity, rel=1e-12)
