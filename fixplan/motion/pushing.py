@@ -18,10 +18,15 @@ counter-clockwise).
 
 - **Sticking**: the contact point moves with the pusher, ``J V = v_p``. Among such twists the
   quasi-static one minimises the dissipation ``h(V)``; its multiplier is the pusher force
-  (``∇h(V) = J^T F = B F``). As the force direction turns across the friction cone, the contact
-  velocity ``J V(F)`` turns the same way (``J ∇²H J^T`` is positive definite), so the force is
-  found by one-dimensional root finding on the angle — in closed form for an ellipsoid, whose
-  sticking force is ``F ∝ (J A J^T)^{-1} v_p`` for ``H(L) = L^T A L``.
+  (``∇h(V) = J^T F = B F``). The twists with ``J V = v_p`` form the line ``V_0 + s N``
+  (``N = (c_y, -c_x, 1)``, rotation about the contact point), along which ``h`` is convex: for a
+  surface with a forward map (``load(twist) = ∇h``) the minimum is one root of
+  ``∇h(V_0 + s N) · N`` (at a facet, a kink of ``h``, the load is the subgradient of the
+  one-sided loads that annuls it). Surfaces with only the inverse map are solved on the force
+  angle instead: as the force turns across the friction cone the contact velocity ``J V(F)``
+  turns the same way (``J ∇²H J^T`` is positive definite). An ellipsoid ``H(L) = L^T A L`` has
+  the closed form ``F ∝ (J A J^T)^{-1} v_p``. The sticking force found, in the friction cone the
+  pusher sticks; outside it, it slides on that side.
 - **Sliding**: when ``v_p`` lies outside the *motion cone* (the contact velocities that the cone's
   two edge forces produce), the force lies on the edge on that side, the twist follows from
   normality there and is scaled so that the normal velocities of pusher and part match; the
@@ -46,8 +51,12 @@ from fixplan.models.ellipsoid import Ellipsoid, FittedEllipsoid
 
 MODES = ("sticking", "sliding-left", "sliding-right", "separated")
 
-#: Root finding on the force angle stops at this many radians (double precision).
+#: Root finding on the force angle stops at this many radians, and on the line of sticking
+#: twists at this fraction of the pusher's speed over the contact's lever (double precision).
 ANGLE_XTOL = 1e-15
+
+#: A sticking force may exceed the friction cone by this fraction (rounding) and still stick.
+CONE_RTOL = 1e-12
 
 
 @dataclass(frozen=True, slots=True)
@@ -111,28 +120,33 @@ def push_step(surface, *, contact, normal, velocity, mu: float) -> PushStep:
         zero = np.zeros(2)
         return PushStep(twist=np.zeros(3), mode="separated",
                         slip=float(velocity @ geometry.tangent), force=zero, load=np.zeros(3))  # fmt: skip
-    right, left = geometry.edge_velocities()
-    side = _side(geometry.normal, right, left, velocity)
+    sticking = geometry.sticking(velocity)
+    if sticking is not None and geometry.in_cone(sticking[1]):
+        twist, force, load = sticking
+        return PushStep(twist=twist, mode="sticking", slip=0.0, force=force, load=load)
+    if sticking is None:
+        side = _side(geometry.normal, *geometry.edge_velocities(), velocity)
+    else:
+        side = 1 if sticking[1] @ geometry.tangent > 0.0 else -1
     if side == 0:
         force = geometry.sticking_force(velocity)
         twist = geometry.unit_twist(force)
         contact_velocity = geometry.jacobian @ twist
         twist = twist * (velocity @ contact_velocity) / (contact_velocity @ contact_velocity)
-        mode = "sticking"
-    else:
-        force = geometry.edge(side)
-        twist = geometry.unit_twist(force)
-        normal_speed = float(geometry.normal @ geometry.jacobian @ twist)
-        if normal_speed <= 0.0:  # pragma: no cover - normality makes it positive
-            raise ModelError("the edge force does not drive the part away from the pusher")
-        twist = twist * push / normal_speed
-        mode = "sliding-left" if side > 0 else "sliding-right"
+        load = geometry.jacobian.T @ force
+        scale = float(geometry.surface.safety_factor(load))
+        return PushStep(twist=twist, mode="sticking", slip=0.0, force=force * scale,
+                        load=load * scale)  # fmt: skip
+    force = geometry.edge(side)
     load = geometry.jacobian.T @ force
-    scale = float(surface.safety_factor(load))
+    twist, scale = geometry.twist_and_scale(load)
+    normal_speed = float(geometry.normal @ geometry.jacobian @ twist)
+    if normal_speed <= 0.0:  # pragma: no cover - normality makes it positive
+        raise ModelError("the edge force does not drive the part away from the pusher")
+    twist = twist * push / normal_speed
     slip = float(geometry.tangent @ (velocity - geometry.jacobian @ twist))
-    if mode == "sticking":
-        slip = 0.0
-    return PushStep(twist=twist, mode=mode, slip=slip, force=force * scale, load=load * scale)
+    return PushStep(twist=twist, mode="sliding-left" if side > 0 else "sliding-right", slip=slip,
+                    force=force * scale, load=load * scale)  # fmt: skip
 
 
 def motion_cone(surface, *, contact, normal, mu: float) -> MotionCone:
@@ -196,7 +210,10 @@ class _Geometry:
 
     def unit_twist(self, force: np.ndarray) -> np.ndarray:
         """The part's unit twist under the pusher force direction ``force`` (normality)."""
-        load = self.jacobian.T @ force
+        return self.unit_twist_of_load(self.jacobian.T @ force)
+
+    def unit_twist_of_load(self, load: np.ndarray) -> np.ndarray:
+        """The part's unit twist under ``load`` (normality)."""
         if self.ellipsoid is not None:
             twist = self.ellipsoid @ load
         else:
@@ -204,6 +221,51 @@ class _Geometry:
         if not np.all(np.isfinite(twist)):
             raise ModelError(f"the surface gives no motion for the load {load}")
         return twist / np.linalg.norm(twist)
+
+    def in_cone(self, force: np.ndarray) -> bool:
+        """Whether ``force`` lies in the pusher's friction cone (to rounding)."""
+        along = float(force @ self.normal)
+        across = abs(float(force @ self.tangent))
+        return along > 0.0 and across <= math.tan(self.half_angle) * along * (1 + CONE_RTOL)
+
+    def twist_and_scale(self, load: np.ndarray) -> tuple[np.ndarray, float]:
+        """Unit twist of ``load`` (normality) and the factor that puts ``load`` on the surface."""
+        if self.ellipsoid is not None:
+            return self.unit_twist_of_load(load), float(self.surface.safety_factor(load))
+        if hasattr(self.surface, "motion_and_safety_factor"):
+            twist, scale = self.surface.motion_and_safety_factor(load)
+            twist = np.asarray(twist, dtype=float)
+            return twist / np.linalg.norm(twist), float(scale)
+        return self.unit_twist_of_load(load), float(self.surface.safety_factor(load))
+
+    def sticking(self, velocity: np.ndarray):
+        """``(twist, force, load)`` of minimum dissipation with ``J V = velocity``, through the
+        forward map; ``None`` for surfaces without one."""
+        forward = getattr(self.surface, "load", None)
+        if forward is None or self.ellipsoid is not None:
+            return None
+        start = np.array([velocity[0], velocity[1], 0.0])
+        turn = np.array([-self.jacobian[0, 2], -self.jacobian[1, 2], 1.0])  # (cy, -cx, 1)
+
+        def slope(s: float) -> float:
+            return float(np.asarray(forward(start + s * turn)) @ turn)
+
+        reach = float(np.linalg.norm(velocity)) / max(float(np.linalg.norm(turn[:2])), 1e-3)
+        low, high = -reach, reach
+        while slope(low) > 0.0:
+            low *= 2.0
+        while slope(high) < 0.0:
+            high *= 2.0
+        s = brentq(slope, low, high, xtol=ANGLE_XTOL * reach, rtol=4 * np.finfo(float).eps)
+        twist = start + s * turn
+        # At a kink of h (a support point at rest) the slope jumps across 0: the load is the
+        # combination of the one-sided loads whose slope is 0 (a subgradient).
+        step = max(abs(s), reach) * 1e-9
+        below, above = (np.asarray(forward(start + x * turn)) for x in (s - step, s + step))
+        a, b = float(below @ turn), float(above @ turn)
+        load = below + (above - below) * (-a / (b - a)) if b - a > 0.0 else forward(twist)
+        force = np.linalg.lstsq(self.jacobian.T, load, rcond=None)[0]
+        return twist, force, self.jacobian.T @ force
 
     def edge_velocities(self) -> tuple[np.ndarray, np.ndarray]:
         """Contact velocities of the right and left edge twists."""
