@@ -5,6 +5,17 @@ imports only from :mod:`fixplan.planner`, :mod:`fixplan.models`, :mod:`fixplan.s
 top-level modules.
 """
 
+from fixplan.motion.outline import Outline
 from fixplan.motion.pushing import MotionCone, PushStep, motion_cone, push_step
+from fixplan.motion.trajectory import PointPusher, Trajectory, push
 
-__all__ = ["MotionCone", "PushStep", "motion_cone", "push_step"]
+__all__ = [
+    "MotionCone",
+    "Outline",
+    "PointPusher",
+    "PushStep",
+    "Trajectory",
+    "motion_cone",
+    "push",
+    "push_step",
+]
