@@ -1,0 +1,97 @@
+"""fixplan's pushing simulation against measured pushes and Zhou's published simulator.
+
+Data (read at run time, never copied into the project): the MIT push dataset (Yu, Bauza,
+Fazeli, Rodriguez, IROS 2016) as prepared by Jiaji Zhou for "A convex polynomial force-motion
+model for planar sliding" (Zhou, Paolini, Bagnell, Mason, ICRA 2016; PlanarManipulationToolBox,
+GPL-2.0): steel objects on an ABS sheet pushed by a steel cylinder of radius 4.75 mm, with Zhou's
+fitted ellipsoidal limit surfaces, his pusher friction and his simulated final poses. See
+``shared/real_data/README.md`` for sources and licences.
+
+For every test push of the chosen groups, the part starts at its measured pose, the pusher's
+centre moves on the measured straight line, and fixplan's :func:`fixplan.motion.push` integrates
+the quasi-static motion with Zhou's ellipsoid (a ``FittedEllipsoid`` with his coefficients) and
+his pusher friction. Printed per group: the measured mean motion, the mean final-pose difference
+to Zhou's simulated poses (the same model: it should vanish), and the mean error against the
+measurements of fixplan and of Zhou's simulator.
+
+Run: ``python examples/pushing_real_data.py [--data DIR] [--group abs/rect1 ...] [--steps N]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from fixplan.models import FittedEllipsoid
+from fixplan.motion import Outline, PointPusher, push
+
+PUSHER_RADIUS = 0.00475  # m, the steel cylinder of the MIT push dataset
+DEFAULT_DATA = Path(__file__).resolve().parents[2] / "shared" / "real_data"
+
+
+def angle_difference(a: float, b: float) -> float:
+    """|a - b| modulo 2π [rad]."""
+    return abs((a - b + math.pi) % (2 * math.pi) - math.pi)
+
+
+def simulate_group(data: Path, group: str, steps: int) -> dict:
+    """Mean errors [mm, deg] of fixplan's simulation of one group's test pushes."""
+    surface_name, shape_name = group.split("/")
+    shapes = json.loads((data / "mcube_shapes.json").read_text())["shapes"]
+    fit = json.loads((data / "mcube_zhou_fits.json").read_text())["fits"][group]["quadratic"]
+    shape = shapes[shape_name]
+    # Zhou's H(x) = xᵀ A x with x = (fx, fy, m / rho): q of a model with mu = 1 and that rho.
+    model = FittedEllipsoid(matrix=np.array(fit["A_normalised"]), mu=1.0, rho=shape["rho_m"])
+    outline = Outline.polygon(shape["vertices_m"])
+    with (data / "mcube_test_pushes.csv").open(newline="") as handle:
+        rows = [r for r in csv.DictReader(handle) if (r["surface"], r["shape"]) == (surface_name,
+                                                                                   shape_name)]  # fmt: skip
+    errors = {"zhou_mm": [], "zhou_deg": [], "ours_mm": [], "ours_deg": [], "sim_mm": [],
+              "sim_deg": [], "moved_mm": [], "turned_deg": []}  # fmt: skip
+    for row in rows:
+        x = {k: float(v) for k, v in row.items() if k not in ("surface", "shape")}
+        start = np.array([x["tipx0_m"], x["tipy0_m"]])
+        velocity = np.array([x["tipx1_m"], x["tipy1_m"]]) - start  # over 1 s
+        pusher = PointPusher((start, velocity), mu=fit["mu_pusher_best"], radius=PUSHER_RADIUS)
+        pose = (x["x0_m"], x["y0_m"], x["th0_rad"])
+        final = push(model, pusher, shape=outline, pose=pose, duration=1.0, steps=steps).poses[-1]
+        measured = np.array([x["x1_m"], x["y1_m"], x["th1_rad"]])
+        zhou = np.array([x["quad_x1_m"], x["quad_y1_m"], x["quad_th1_rad"]])
+        for key, a, b in (
+            ("zhou", final, zhou),
+            ("ours", final, measured),
+            ("sim", zhou, measured),
+        ):
+            errors[f"{key}_mm"].append(1000 * np.linalg.norm(a[:2] - b[:2]))
+            errors[f"{key}_deg"].append(math.degrees(angle_difference(a[2], b[2])))
+        errors["moved_mm"].append(1000 * math.hypot(x["x1_m"] - x["x0_m"], x["y1_m"] - x["y0_m"]))
+        errors["turned_deg"].append(math.degrees(angle_difference(x["th1_rad"], x["th0_rad"])))
+    return {"pushes": len(rows), **{k: float(np.mean(v)) for k, v in errors.items()}}
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--data", type=Path, default=DEFAULT_DATA, help="the real_data folder")
+    parser.add_argument("--group", nargs="+", default=["abs/rect1"], help="surface/shape groups")
+    parser.add_argument("--steps", type=int, default=100, help="integration steps per push")
+    args = parser.parse_args(argv)
+    print("pushing with Zhou's ellipsoid and pusher friction (MIT push dataset, ABS sheet);")
+    print("errors are mean final-pose differences over the group's test pushes")
+    print(f"{'group':12s} {'pushes':>6s} {'moved':>14s} {'fixplan-Zhou':>16s} {'fixplan-meas.':>16s}"
+          f" {'Zhou-meas.':>16s}")  # fmt: skip
+    for group in args.group:
+        r = simulate_group(args.data, group, args.steps)
+        print(
+            f"{group:12s} {r['pushes']:6d} {r['moved_mm']:6.1f} mm {r['turned_deg']:4.1f}° "
+            f"{r['zhou_mm']:7.3f} mm {r['zhou_deg']:5.3f}° {r['ours_mm']:7.2f} mm {r['ours_deg']:5.2f}° "
+            f"{r['sim_mm']:7.2f} mm {r['sim_deg']:5.2f}°"
+        )
+
+
+if __name__ == "__main__":
+    main()
