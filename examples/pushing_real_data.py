@@ -33,6 +33,10 @@ from fixplan.motion import Outline, PointPusher, push
 PUSHER_RADIUS = 0.00475  # m, the steel cylinder of the MIT push dataset
 DEFAULT_DATA = Path(__file__).resolve().parents[2] / "shared" / "real_data"
 
+#: Largest mean difference from Zhou's simulated final poses that counts as reproducing them
+#: (the same model and pusher friction; what remains is integration and contact handling).
+AGREEMENT_MM, AGREEMENT_DEG = 0.2, 0.2
+
 
 def angle_difference(a: float, b: float) -> float:
     """|a - b| modulo 2π [rad]."""
@@ -78,8 +82,14 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--data", type=Path, default=DEFAULT_DATA, help="the real_data folder")
     parser.add_argument("--group", nargs="+", default=["abs/rect1"], help="surface/shape groups")
-    parser.add_argument("--steps", type=int, default=100, help="integration steps per push")
+    parser.add_argument("--steps", type=int, default=50, help="integration steps per push")
+    parser.add_argument(
+        "--check", action="store_true",
+        help=f"exit 1 when fixplan is farther than {AGREEMENT_MM} mm or {AGREEMENT_DEG}° from "
+        "Zhou's simulated final poses on average (a regression)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
+    failed = []
     print("pushing with Zhou's ellipsoid and pusher friction (MIT push dataset, ABS sheet);")
     print("errors are mean final-pose differences over the group's test pushes")
     print(f"{'group':12s} {'pushes':>6s} {'moved':>14s} {'fixplan-Zhou':>16s} {'fixplan-meas.':>16s}"
@@ -91,6 +101,10 @@ def main(argv: list[str] | None = None) -> None:
             f"{r['zhou_mm']:7.3f} mm {r['zhou_deg']:5.3f}° {r['ours_mm']:7.2f} mm {r['ours_deg']:5.2f}° "
             f"{r['sim_mm']:7.2f} mm {r['sim_deg']:5.2f}°"
         )
+        if r["zhou_mm"] > AGREEMENT_MM or r["zhou_deg"] > AGREEMENT_DEG:
+            failed.append(group)
+    if args.check and failed:
+        raise SystemExit(f"regression: fixplan no longer reproduces Zhou's simulator on {failed}")
 
 
 if __name__ == "__main__":
