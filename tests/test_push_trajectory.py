@@ -75,3 +75,78 @@ def test_bad_trajectory_arguments_are_refused():
         push(SUPPORT, pusher, shape=[[0, 0], [1, 0], [0, 1]], duration=1.0, steps=5)
     with pytest.raises(InvalidArgumentError, match="path"):
         PointPusher(path=3.0, mu=0.3)
+
+
+def _uniform_disk_limits(u: float) -> tuple[float, float]:
+    """``(|f| / (mu N), |m| / (mu N R))`` of a uniform disk sliding about a centre of rotation
+    ``u R`` from its centre (DESIGN.md §4, complete elliptic integrals of modulus k)."""
+    from scipy.special import ellipe, ellipk
+
+    if u <= 1.0:
+        e, k = ellipe(u * u), ellipk(u * u)
+        force = 4 / (3 * np.pi * u) * ((1 + u * u) * e - (1 - u * u) * k)
+        moment = 4 / (9 * np.pi) * (2 * (2 - u * u) * e - (1 - u * u) * k)
+    else:
+        e, k = ellipe(1 / (u * u)), ellipk(1 / (u * u))
+        force = 4 / (3 * np.pi) * ((1 + u * u) * e - (u * u - 1) * k)
+        moment = 4 / (9 * np.pi) * (2 * u * (2 - u * u) * e + (u * u - 1) * (2 * u * u - 3) / u * k)
+    return force, moment
+
+
+def _frictionless_face_push(radius, start, speed, start_time, end_time):
+    """Independent integration of a square part on a uniform disk pushed on its left face (normal
+    +x in the part frame) by a frictionless point moving along world +x: the load is
+    F (1, 0, -cy); by symmetry the centre of rotation is (0, y_r) with |m|/|f| = |cy| from the
+    closed-form limit curves, the twist (w y_r, 0, w), scaled so that the contact point keeps the
+    pusher's speed along the face normal."""
+    from scipy.integrate import solve_ivp
+    from scipy.optimize import brentq
+
+    def twist(pose, t):
+        c, s = np.cos(pose[2]), np.sin(pose[2])
+        pusher = np.array([start[0] + speed * t, start[1]])
+        local = np.array([[c, s], [-s, c]]) @ (pusher - pose[:2])
+        along_normal = c * speed  # the pusher's velocity along the face normal, part frame
+        lever = local[1]
+        if abs(lever) < 1e-12 * radius:
+            return np.array([along_normal, 0.0, 0.0])
+
+        def gap(log_u):
+            force, moment = _uniform_disk_limits(np.exp(log_u))
+            return radius * moment / force - abs(lever)
+
+        u = np.exp(brentq(gap, -6.0, 6.0, xtol=1e-14))
+        y_r = -np.sign(lever) * u * radius  # the part turns away from the pushed side
+        w = along_normal / (y_r - lever)
+        return np.array([w * y_r, 0.0, w])
+
+    def rate(t, pose):
+        body = twist(pose, t)
+        c, s = np.cos(pose[2]), np.sin(pose[2])
+        return [c * body[0] - s * body[1], s * body[0] + c * body[1], body[2]]
+
+    solution = solve_ivp(rate, (start_time, end_time), [0.0, 0.0, 0.0], rtol=1e-11, atol=1e-13)
+    return solution.y[:, -1]
+
+
+def test_a_frictionless_face_push_on_a_uniform_disk_matches_an_independent_integration():
+    # A 80 mm square on a uniform disk of radius 40 mm, pushed 15 mm off centre along x by a
+    # frictionless point: the part turns clockwise, the contact first slides towards the middle
+    # of the face, then the part turns away (a frictionless point push on a face is unstable).
+    # Compared while the contact stays on the face, with a lever of at least a few millimetres
+    # (where the closed forms are well conditioned).
+    radius, start, speed, end = 0.04, (-0.1, 0.015), 0.05, 2.8
+    support = LimitSurface(pressure.disk(radius), mu=0.5, normal_force=2.0)
+    pusher = PointPusher((list(start), [speed, 0.0]), mu=0.0)
+    shape = Outline.rectangle(0.08, 0.08)
+    trajectory = push(support, pusher, shape=shape, duration=end, steps=800)  # error ~1e-6
+    expected = _frictionless_face_push(radius, start, speed, (0.1 - 0.04) / speed, end)
+    np.testing.assert_allclose(trajectory.poses[-1], expected, atol=2e-6)
+    assert expected[2] < -0.5  # it turned clockwise
+    levers = []
+    for t, pose in zip(trajectory.t, trajectory.poses, strict=True):
+        c, s = np.cos(pose[2]), np.sin(pose[2])
+        levers.append(np.array([-s, c]) @ (np.array([start[0] + speed * t, start[1]]) - pose[:2]))
+    assert (
+        min(levers) < 0.4 * 0.015 and max(np.abs(levers)) < 0.04
+    )  # towards the middle; on the face
