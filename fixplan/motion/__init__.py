@@ -7,6 +7,7 @@ top-level modules.
 
 from fixplan.motion.outline import Outline
 from fixplan.motion.pushing import MotionCone, PushStep, motion_cone, push_step
+from fixplan.motion.sliding import Sliding, slide
 from fixplan.motion.trajectory import PointPusher, Trajectory, push
 
 __all__ = [
@@ -14,8 +15,10 @@ __all__ = [
     "Outline",
     "PointPusher",
     "PushStep",
+    "Sliding",
     "Trajectory",
     "motion_cone",
     "push",
     "push_step",
+    "slide",
 ]
