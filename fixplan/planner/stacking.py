@@ -98,17 +98,20 @@ def _stack_cones(forms: list[ConicForm], starts, aux_starts) -> dict:
             count = rows.size
             normal.append(sp.coo_array((form.normal[rows], (np.arange(count), np.full(count, i))),
                                        shape=(count, contacts)))  # fmt: skip
-            block = np.zeros((count, width))
-            block[:, starts[i] : starts[i + 1]] = form.load[rows]
-            friction.append(sp.coo_array(block))
-            block = np.zeros((count, aux_width))
-            block[:, aux_starts[i] : aux_starts[i + 1]] = form.aux[rows]
-            aux.append(sp.coo_array(block))
+            friction.append(_placed(form.load[rows], int(starts[i]), width))
+            aux.append(_placed(form.aux[rows], int(aux_starts[i]), aux_width))
         if normal:
             stacked[kind, size] = tuple(
                 sp.vstack(part, format="csr") for part in (normal, friction, aux)
             )
     return stacked
+
+
+def _placed(block: np.ndarray, start: int, width: int) -> sp.coo_array:
+    """``block`` as the sparse columns ``start ...`` of a matrix ``width`` columns wide."""
+    sparse = sp.coo_array(block)
+    return sp.coo_array((sparse.data, (sparse.row, sparse.col + start)),
+                        shape=(block.shape[0], width))  # fmt: skip
 
 
 @dataclass(frozen=True, slots=True)
