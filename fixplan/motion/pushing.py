@@ -85,6 +85,12 @@ class PushStep:
     force: np.ndarray
     load: np.ndarray
 
+    @classmethod
+    def separated(cls, slip: float = 0.0) -> PushStep:
+        """The part at rest, the pusher not pressing on it (moving by ``slip`` [m/s] along ``t``)."""
+        return cls(twist=np.zeros(3), mode="separated", slip=slip, force=np.zeros(2),
+                   load=np.zeros(3))  # fmt: skip
+
 
 @dataclass(frozen=True, slots=True)
 class MotionCone:
@@ -117,9 +123,7 @@ def push_step(surface, *, contact, normal, velocity, mu: float) -> PushStep:
     velocity = validation.finite_array("velocity", velocity, shape=(2,))
     push = float(velocity @ geometry.normal)
     if push <= 0.0:
-        zero = np.zeros(2)
-        return PushStep(twist=np.zeros(3), mode="separated",
-                        slip=float(velocity @ geometry.tangent), force=zero, load=np.zeros(3))  # fmt: skip
+        return PushStep.separated(float(velocity @ geometry.tangent))
     sticking = geometry.sticking(velocity)
     if sticking is not None and geometry.in_cone(sticking[1]):
         twist, force, load = sticking

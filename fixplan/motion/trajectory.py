@@ -136,7 +136,7 @@ def push(
         start = k * dt
         touch = _touching_time(shape, pusher, pose, start, dt, tolerance)
         if touch is None:
-            step, contact = _rest(), None
+            step, contact = PushStep.separated(), None
         else:
             rest = start + dt - touch
             step, contact = _step(surface, shape, pusher, pose, touch)
@@ -157,11 +157,6 @@ def push(
         t=np.array(times), poses=np.array(poses), twists=np.array(twists), modes=tuple(modes),
         forces=np.array(forces), contact_points=np.array(points),
     )  # fmt: skip
-
-
-def _rest() -> PushStep:
-    zero = np.zeros(2)
-    return PushStep(twist=np.zeros(3), mode="separated", slip=0.0, force=zero, load=np.zeros(3))
 
 
 def _local(pose: np.ndarray, point: np.ndarray) -> np.ndarray:
