@@ -109,6 +109,22 @@ def test_ellipsoid_cvxpy_form_is_one_second_order_cone(disk):
     assert isinstance(constraint, cp.constraints.SOC)
 
 
+@pytest.mark.parametrize("kind", [Ellipsoid, FittedEllipsoid])
+def test_the_load_matrix_is_the_ellipsoid_in_loads_about_the_frame_origin(kind, skewed):
+    # The skewed field's ellipsoid is tilted and centred off the origin: L^T A L must still be
+    # the squared gauge at unit normal force, and A L the model's motion.
+    model = kind.from_limit_surface(skewed)
+    loads = np.random.default_rng(3).normal(size=(20, 3)) * [1.0, 1.0, 0.02]
+    quadratic = np.einsum("ki,ij,kj->k", loads, model.load_matrix, loads)
+    np.testing.assert_allclose(model.safety_factor(loads, normal_force=1.0), quadratic**-0.5,
+                               rtol=1e-12)  # fmt: skip
+    normals = loads @ model.load_matrix
+    motions = model.motion(loads)
+    cosine = np.einsum("ki,ki->k", normals, motions) / np.linalg.norm(normals, axis=1)
+    cosine /= np.linalg.norm(motions, axis=1)
+    np.testing.assert_allclose(cosine, 1.0, atol=1e-12)
+
+
 # -- FittedEllipsoid ---------------------------------------------------------------------------
 
 

@@ -162,6 +162,15 @@ class FrictionModel(ConvexForm, ABC):
             return np.array([mu, mu, mu * self.rho])
         return np.array([mu, mu])
 
+    def _normalising_map(self) -> np.ndarray:
+        """The matrix that takes a load about the frame origin to its normalised coordinates
+        ``q`` (moment about :attr:`center`, divided by the units), ``(3, 3)`` or ``(2, 2)``."""
+        if not self.torsion:
+            return np.diag(1.0 / self._units())
+        cx, cy = self.center
+        about_center = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [cy, -cx, 1.0]])
+        return about_center / self._units()[:, None]
+
     # -- numeric queries ---------------------------------------------------------------------
 
     def _normalised(self, load, normal_force) -> tuple[np.ndarray, bool, np.ndarray]:

@@ -46,12 +46,7 @@ class ConvexForm:
                 cones=(("zero", width),),
             )  # fmt: skip
         unit = self._unit_conic()
-        if self.torsion:
-            cx, cy = self.center
-            about_center = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [cy, -cx, 1.0]])
-        else:
-            about_center = np.eye(2)
-        to_q = about_center / self._units()[:, None]
+        to_q = self._normalising_map()
         return ConicForm(normal=unit.normal, load=unit.load @ to_q, aux=unit.aux, cones=unit.cones)
 
     def constraints(self, load, normal_force) -> list:

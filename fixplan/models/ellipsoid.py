@@ -208,6 +208,12 @@ class Ellipsoid(FrictionModel):
         shear = _shear(self.tilt)
         return shear.T @ shear
 
+    @property
+    def load_matrix(self) -> np.ndarray:
+        """Matrix ``A`` [1/N², …] of the ellipsoid ``L^T A L <= 1`` for loads ``(fx, fy, m)``
+        about the frame origin at unit normal force; its normals are ``A L``."""
+        return _load_matrix(self)
+
     def _gauge(self, q):
         t = self.tilt
         fx = q[:, 0] - t[0] * q[:, 2]
@@ -360,6 +366,11 @@ class FittedEllipsoid(FrictionModel):
     def _normal(self, q):
         return q @ self.matrix
 
+    @property
+    def load_matrix(self) -> np.ndarray:
+        """As :attr:`Ellipsoid.load_matrix`."""
+        return _load_matrix(self)
+
     def _unit_conic(self):
         return _ellipsoid_conic(self._factor)
 
@@ -371,6 +382,12 @@ class FittedEllipsoid(FrictionModel):
             f"FittedEllipsoid(mu={fmt(self.mu)}, rho={fmt(self.rho)} m, {center}"
             f"normal_force={fmt(self.normal_force)} N, fit_error={self.fit_error:.3g})"
         )
+
+
+def _load_matrix(model) -> np.ndarray:
+    """``A`` with ``L^T A L = q^T M q``: the ellipsoid in load coordinates."""
+    to_q = model._normalising_map()
+    return to_q.T @ model.matrix @ to_q
 
 
 def _ellipsoid_conic(factor: np.ndarray):

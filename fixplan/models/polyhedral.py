@@ -248,9 +248,7 @@ class Pyramid(FrictionModel):
         """
         force = self.normal_force if normal_force is None else normal_force
         force = validation.positive_scalar("normal_force", force)
-        cx, cy = self.center
-        about_center = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [cy, -cx, 1.0]])
-        matrix = self._rows / self._units()[None, :] @ about_center
+        matrix = self._rows @ self._normalising_map()
         return matrix, np.full(len(self._rows), 0.0 if self.frictionless else force)
 
     def _gauge(self, q):

@@ -314,5 +314,4 @@ def _ellipsoid_matrix(surface) -> np.ndarray | None:
     """``A`` of an ellipsoid model ``H(L) = L^T A L`` (its normals are ``A L``), else ``None``."""
     if not isinstance(surface, Ellipsoid | FittedEllipsoid) or surface.frictionless:
         return None
-    factor = surface.conic_form().load[1:4]  # the cone's rows below N: ||F L|| <= N
-    return factor.T @ factor
+    return surface.load_matrix
