@@ -108,7 +108,7 @@ class Plan:
 
     def describe_held(self, load_name: str) -> str:
         """Whether load case ``load_name`` is held, and for which multiples of its task load,
-        in words (e.g. ``"held for 0.61–2.05 × the task load"``)."""
+        in words (e.g. ``"held for 0–2.05 × the task load"``)."""
         if load_name not in self.held_intervals:
             return "not analysed"
         low, high = self.held_intervals[load_name]

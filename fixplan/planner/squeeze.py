@@ -1,11 +1,11 @@
 r"""Passive contacts that squeeze each other, and the rule that keeps them from doing so.
 
 A *squeeze* is a set of passive normal forces ``s >= 0``, ``s != 0``, whose wrenches cancel,
-``G_p s = 0`` (two opposing locators pressing on each other through the part). A rigid model
-admits any amount of it, and with it friction that no active force or load causes: a block
-between two opposing locators is "held" by 276 N that each locator applies to the other. Which
-squeeze really acts depends on the compliance and the preload of the contacts, which the rigid
-model does not know.
+``G_p s = 0`` (two opposing locators pressing on each other through the part). A rigid model admits any
+amount of it, and with it friction that no active force or load causes: a block between two opposing
+point locators (mu 0.3, pushed sideways with 100 N) is "held" by 253 N that each locator applies to
+the other. Which squeeze really acts depends on the compliance and the preload of the contacts,
+which the rigid model does not know.
 
 Rule: the passive normal forces of every load case are *squeeze-free*: no squeeze fits under
 them (there is no ``s`` with ``0 <= s <= f_p``), i.e. in every squeeze at least one contact carries
