@@ -124,23 +124,20 @@ def push_step(surface, *, contact, normal, velocity, mu: float) -> PushStep:
     push = float(velocity @ geometry.normal)
     if push <= 0.0:
         return PushStep.separated(float(velocity @ geometry.tangent))
-    sticking = geometry.sticking(velocity)
-    if sticking is not None and geometry.in_cone(sticking[1]):
-        twist, force, load = sticking
-        return PushStep(twist=twist, mode="sticking", slip=0.0, force=force, load=load)
+    # Sticking: through the forward map where the surface has one (then the force found tells
+    # the side it slides on if it lies outside the cone), else from the motion cone.
+    sticking = geometry.sticking_by_forward_map(velocity)
     if sticking is None:
         side = _side(geometry.normal, *geometry.edge_velocities(), velocity)
+        if side == 0:
+            sticking = geometry.sticking_in_cone(velocity)
+    elif geometry.in_cone(sticking[1]):
+        side = 0
     else:
         side = 1 if sticking[1] @ geometry.tangent > 0.0 else -1
     if side == 0:
-        force = geometry.sticking_force(velocity)
-        twist = geometry.unit_twist(force)
-        contact_velocity = geometry.jacobian @ twist
-        twist = twist * (velocity @ contact_velocity) / (contact_velocity @ contact_velocity)
-        load = geometry.jacobian.T @ force
-        scale = float(geometry.surface.safety_factor(load))
-        return PushStep(twist=twist, mode="sticking", slip=0.0, force=force * scale,
-                        load=load * scale)  # fmt: skip
+        twist, force, load = sticking
+        return PushStep(twist=twist, mode="sticking", slip=0.0, force=force, load=load)
     force = geometry.edge(side)
     load = geometry.jacobian.T @ force
     twist, scale = geometry.twist_and_scale(load)
@@ -242,7 +239,7 @@ class _Geometry:
             return twist / np.linalg.norm(twist), float(scale)
         return self.unit_twist_of_load(load), float(self.surface.safety_factor(load))
 
-    def sticking(self, velocity: np.ndarray):
+    def sticking_by_forward_map(self, velocity: np.ndarray):
         """``(twist, force, load)`` of minimum dissipation with ``J V = velocity``, through the
         forward map; ``None`` for surfaces without one."""
         forward = getattr(self.surface, "load", None)
@@ -274,6 +271,17 @@ class _Geometry:
     def edge_velocities(self) -> tuple[np.ndarray, np.ndarray]:
         """Contact velocities of the right and left edge twists."""
         return tuple(self.jacobian @ self.unit_twist(self.edge(side)) for side in (-1, 1))
+
+    def sticking_in_cone(self, velocity: np.ndarray):
+        """``(twist, force, load)`` of a pusher that sticks, for ``velocity`` inside the motion
+        cone, through the inverse map (or the ellipsoid's closed form)."""
+        direction = self.sticking_force(velocity)
+        twist = self.unit_twist(direction)
+        moved = self.jacobian @ twist
+        twist = twist * (velocity @ moved) / (moved @ moved)
+        load = self.jacobian.T @ direction
+        scale = float(self.surface.safety_factor(load))
+        return twist, direction * scale, load * scale
 
     def sticking_force(self, velocity: np.ndarray) -> np.ndarray:
         """The unit force whose twist moves the contact point along ``velocity``."""
