@@ -56,25 +56,38 @@ Patch shapes (lengths [m], coordinates in the contact's patch frame):
 
 from __future__ import annotations
 
-import csv
-import difflib
-import functools
 import hashlib
 import math
 import os
-import re
-import reprlib
-import stat
-import tomllib
-from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from datetime import date, datetime, time
 from pathlib import Path
 
 import numpy as np
 
 from fixplan import validation
-from fixplan.errors import FixplanError, InvalidArgumentError
+from fixplan.errors import InvalidArgumentError
+from fixplan.io.patch_schema import read_patch
+from fixplan.io.toml_schema import (
+    MAX_FILE_BYTES,
+    Array,
+    Boolean,
+    Choice,
+    Integer,
+    InvalidValueError,
+    Issue,
+    Kind,
+    Number,
+    ProblemFileError,
+    Table,
+    Text,
+    build,
+    check_schema_version,
+    check_unique_names,
+    describe,
+    given,
+    parse_toml,
+    read_regular_file,
+)
 from fixplan.planner.contact_models import PLANNER_EXACT_ORDER, contact_model
 from fixplan.planner.problem import (
     AREA_MODEL_NAMES,
@@ -90,27 +103,17 @@ from fixplan.planner.problem import (
 from fixplan.surface import pressure
 from fixplan.tolerances import (
     MAX_ACCELERATION,
-    MAX_ASPECT_RATIO,
     MAX_EXACT_POINTS,
     MAX_FACETS,
     MAX_FORCE,
-    MAX_GRID_CELLS,
     MAX_LENGTH,
     MAX_MASS,
     MAX_MU,
-    MAX_NAME_LENGTH,
-    MAX_POINTS,
-    MAX_POLYGON_VERTICES,
-    MAX_RELATIVE_VALUE,
     MAX_TORQUE,
     MIN_MU,
-    MIN_PATCH_LENGTH,
 )
 
-#: The version of the schema this module reads.
-SCHEMA_VERSION = 1
 KINDS = ("fixture", "grasp")
-PATCH_SHAPES = ("disk", "rectangle", "polygon", "points", "grid")
 PYRAMID_MODEL_NAMES = ("pyramid", "point-pyramid")
 #: The point model a model override gives to contacts without a patch.
 POINT_VERSION = {
@@ -119,9 +122,6 @@ POINT_VERSION = {
     "cone": "point-cone",
     "pyramid": "point-pyramid",
 }
-
-#: Largest problem file, and largest CSV file of a grid patch, read [bytes].
-MAX_FILE_BYTES = 10_000_000
 
 #: A contact normal in a file must have length 1 within this absolute tolerance (a guard against
 #: typos; the value is normalised exactly when the contact is built).
@@ -158,58 +158,6 @@ _CONTACT_KEYS = (
     "max_force",
 )
 _LOAD_KEYS = ("name", "force", "point", "torque")
-_PATCH_KEYS = {
-    "disk": ("shape", "radius", "pressure", "inner_radius"),
-    "rectangle": ("shape", "length", "width", "pressure", "axis"),
-    "polygon": ("shape", "vertices"),
-    "points": ("shape", "xy", "weights"),
-    "grid": ("shape", "x", "y", "values"),
-}
-
-_SHORT = reprlib.Repr()
-_SHORT.maxstring = _SHORT.maxother = 40
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Issue:
-    """One mistake in a problem file.
-
-    Attributes
-    ----------
-    key_path : str
-        Where the mistake is, e.g. ``"contacts[2].mu"`` (0-based indices); ``""`` for the file
-        as a whole (unreadable, not TOML).
-    message : str
-        What is wrong and what is expected.
-    """
-
-    key_path: str
-    message: str
-
-    def __str__(self) -> str:
-        return f"{self.key_path}: {self.message}" if self.key_path else self.message
-
-
-class ProblemFileError(FixplanError, ValueError):
-    """A problem file cannot be read or is invalid; lists every issue found.
-
-    ``str(error)`` has one line per issue, ``FILE: key.path: message``.
-
-    Attributes
-    ----------
-    path : Path
-        The problem file.
-    issues : list of Issue
-        Every mistake found, in the order found.
-    """
-
-    def __init__(self, path: str | os.PathLike[str], issues: Sequence[Issue]):
-        self.path = Path(path)
-        self.issues = list(issues)
-        super().__init__(self.path, self.issues)
-
-    def __str__(self) -> str:
-        return "\n".join(f"{self.path}: {issue}" for issue in self.issues)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -269,11 +217,11 @@ def load_problem(path: str | os.PathLike[str], *, model: str | None = None) -> P
     if model is not None:
         model = validation.choice("model", model, MODEL_NAMES)
     try:
-        content = _read_regular_file(path, MAX_FILE_BYTES)
-    except _InvalidValueError as exc:
+        content = read_regular_file(path, MAX_FILE_BYTES)
+    except InvalidValueError as exc:
         message = f"cannot read the file: {exc}"
         raise ProblemFileError(path, [Issue(key_path="", message=message)]) from None
-    document = _parse_toml(path, content)
+    document = parse_toml(path, content)
     reader = _Reader(folder=path.parent, model=model)
     name, kind, problem = reader.document(document)
     if reader.issues or problem is None:
@@ -286,37 +234,6 @@ def load_problem(path: str | os.PathLike[str], *, model: str | None = None) -> P
         sha256=hashlib.sha256(content).hexdigest(),
         model_override=model,
     )
-
-
-def _read_regular_file(path: Path, limit: int) -> bytes:
-    """The bytes of the regular file ``path`` of at most ``limit`` bytes; the error's message
-    says why it cannot be read.
-
-    The file type is checked before the file is opened: reading a FIFO or a device would block
-    or never end.
-    """
-    try:
-        status = path.stat()
-    except (OSError, ValueError) as exc:
-        raise _InvalidValueError(_reason(exc)) from None
-    if not stat.S_ISREG(status.st_mode):
-        kind = "a folder" if stat.S_ISDIR(status.st_mode) else "not a regular file"
-        raise _InvalidValueError(f"it is {kind}")
-    if status.st_size > limit:
-        raise _InvalidValueError(f"it has {status.st_size} bytes, more than the {limit} accepted")
-    try:
-        return path.read_bytes()
-    except OSError as exc:
-        raise _InvalidValueError(_reason(exc)) from None
-
-
-def _reason(exc: Exception) -> str:
-    """Why a file operation failed, without the path (the message names it already)."""
-    if isinstance(exc, OSError) and exc.strerror:
-        return exc.strerror
-    if isinstance(exc, ValueError):
-        return "the path is not valid (it holds a NUL character)"
-    return str(exc)
 
 
 def check_problem(path: str | os.PathLike[str], *, model: str | None = None) -> ProblemFile:
@@ -343,337 +260,24 @@ def check_problem(path: str | os.PathLike[str], *, model: str | None = None) -> 
     return problem_file
 
 
-def _parse_toml(path: Path, content: bytes) -> dict:
-    """The TOML document of ``content``; a leading UTF-8 byte-order mark is ignored."""
-    try:
-        return tomllib.loads(content.decode("utf-8-sig"))
-    except UnicodeDecodeError as exc:
-        message = f"not UTF-8 text (byte {exc.start} cannot be decoded); save it as UTF-8"
-        raise ProblemFileError(path, [Issue(key_path="", message=message)]) from exc
-    except tomllib.TOMLDecodeError as exc:
-        message = f"TOML syntax error: {exc}"
-        raise ProblemFileError(path, [Issue(key_path="", message=message)]) from exc
-    except RecursionError:
-        message = "tables or arrays are nested too deeply to read (hundreds of levels)"
-        raise ProblemFileError(path, [Issue(key_path="", message=message)]) from None
-
-
-class _InvalidValueError(Exception):
-    """A value does not fit its key; the message says what was expected."""
-
-
-def _describe(value: object) -> str:
-    """A value named by its TOML type, e.g. ``string 'abc'`` or ``boolean true``."""
-    if isinstance(value, bool):
-        return f"boolean {str(value).lower()}"
-    if isinstance(value, dict):
-        return "a table"
-    names = {int: "integer", float: "float", str: "string", list: "array"}
-    names.update({datetime: "date-time", date: "date", time: "time"})
-    kind = next(name for cls, name in names.items() if isinstance(value, cls))
-    text = _SHORT.repr(value) if isinstance(value, str | list) else str(value)
-    return f"{kind} {text}"
-
-
-def _key_text(key: str) -> str:
-    """``key`` as written in TOML: bare if it can be, quoted otherwise."""
-    return key if re.fullmatch(r"[A-Za-z0-9_-]+", key) else f'"{key}"'
-
-
-def _suggestion(word: str, allowed: Sequence[str]) -> str | None:
-    close = difflib.get_close_matches(word, allowed, n=1)
-    return close[0] if close else None
-
-
-def _finite(value: object) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise _InvalidValueError(f"expected a number, got {_describe(value)}")
-    try:
-        number = float(value)  # TOML integers have no size limit
-    except OverflowError:
-        raise _InvalidValueError(
-            f"expected a finite number, got an integer too large for a float ({len(str(value))} "
-            "digits)"
-        ) from None
-    if not math.isfinite(number):
-        raise _InvalidValueError(f"expected a finite number, got {value}")
-    return number
-
-
-@dataclass(frozen=True, slots=True)
-class _Number:
-    """A finite number, optionally bounded below (``bound`` is ``"> 0"`` or ``">= 0"``) and in
-    size (``limit``, in ``unit``); positive values below ``smallest`` are rejected with
-    ``why_smallest``."""
-
-    bound: str = ""
-    limit: float | None = None
-    unit: str = ""
-    smallest: float | None = None
-    why_smallest: str = ""
-
-    @property
-    def expected(self) -> str:
-        return f"a number {self.bound}".rstrip()
-
-    @property
-    def accepted_range(self) -> str:
-        unit = f" {self.unit}" if self.unit else ""
-        if self.bound:
-            return f"a number {self.bound} and at most {self.limit:g}{unit}"
-        return f"a number within ±{self.limit:g}{unit}"
-
-    def __call__(self, value: object) -> float:
-        number = _finite(value)
-        if (self.bound == "> 0" and number <= 0.0) or (self.bound == ">= 0" and number < 0.0):
-            raise _InvalidValueError(f"expected {self.expected}, got {value}")
-        if self.limit is not None and abs(number) > self.limit:
-            raise _InvalidValueError(f"expected {self.accepted_range}, got {value}")
-        if self.smallest is not None and 0.0 < number < self.smallest:
-            raise _InvalidValueError(
-                f"expected {self.accepted_range}, got {value}: below {self.smallest:g} "
-                f"{self.why_smallest}"
-            )
-        return number
-
-
-@dataclass(frozen=True, slots=True)
-class _Integer:
-    """An integer from ``minimum`` to ``maximum``."""
-
-    minimum: int
-    maximum: int
-
-    @property
-    def expected(self) -> str:
-        return f"an integer >= {self.minimum}"
-
-    def __call__(self, value: object) -> int:
-        if isinstance(value, bool) or not isinstance(value, int) or value < self.minimum:
-            raise _InvalidValueError(f"expected {self.expected}, got {_describe(value)}")
-        if value > self.maximum:
-            raise _InvalidValueError(
-                f"expected an integer from {self.minimum} to {self.maximum}, got {value}"
-            )
-        return value
-
-
-@dataclass(frozen=True, slots=True)
-class _Boolean:
-    expected: str = "true or false"
-
-    def __call__(self, value: object) -> bool:
-        if not isinstance(value, bool):
-            raise _InvalidValueError(f"expected {self.expected}, got {_describe(value)}")
-        return value
-
-
-@dataclass(frozen=True, slots=True)
-class _Text:
-    """A non-empty string; a name (``name=True``) has at most ``MAX_NAME_LENGTH`` characters
-    and no control characters (names become headings and file names of reports)."""
-
-    name: bool = False
-
-    @property
-    def expected(self) -> str:
-        if self.name:
-            return f"a name of 1 to {MAX_NAME_LENGTH} characters without control characters"
-        return "a non-empty string"
-
-    def __call__(self, value: object) -> str:
-        if (
-            not isinstance(value, str)
-            or not value.strip()
-            or (self.name and (len(value) > MAX_NAME_LENGTH or not value.isprintable()))
-        ):
-            got = f"{len(value)} characters" if isinstance(value, str) and len(value) > 40 else ""
-            raise _InvalidValueError(f"expected {self.expected}, got {got or _describe(value)}")
-        return value
-
-
-@dataclass(frozen=True, slots=True)
-class _Choice:
-    """One of the strings ``allowed``."""
-
-    allowed: tuple[str, ...]
-
-    @property
-    def expected(self) -> str:
-        return "one of " + ", ".join(repr(a) for a in self.allowed)
-
-    def __call__(self, value: object) -> str:
-        if value in self.allowed:
-            return str(value)
-        message = f"expected {self.expected}; got {_describe(value)}"
-        close = _suggestion(value, self.allowed) if isinstance(value, str) else None
-        raise _InvalidValueError(message + (f" (did you mean {close!r}?)" if close else ""))
-
-
-@dataclass(frozen=True, slots=True)
-class _Array:
-    """Nested non-empty arrays of ``shape`` (``None``: any length, up to ``max_items`` in the
-    first dimension) of numbers of the kind ``element``."""
-
-    shape: tuple[int | None, ...]
-    element: _Number = _Number()
-    max_items: int | None = None
-
-    @property
-    def expected(self) -> str:
-        text = _shape_text(self.shape)
-        return f"{text}, at most {self.max_items} of them" if self.max_items else text
-
-    def __call__(self, value: object) -> list:
-        if self.max_items is not None and isinstance(value, list) and len(value) > self.max_items:
-            raise _InvalidValueError(f"expected at most {self.max_items} items, got {len(value)}")
-        return _nested(value, self.shape, self.element, "")
-
-
-def _shape_text(shape: tuple[int | None, ...], *, plural: bool = False) -> str:
-    """The structure of nested arrays in words (the elements' range is told where one is out
-    of it)."""
-    if not shape:
-        return "numbers" if plural else "a number"
-    count = "" if shape[0] is None else f"{shape[0]} "
-    head = "arrays" if plural else "an array"
-    return f"{head} of {count}{_shape_text(shape[1:], plural=True)}"
-
-
-def _nested(
-    value: object, shape: tuple[int | None, ...], element: _Number, index: str
-) -> list | float:
-    where = f"element {index}: " if index else ""
-    if not shape:
-        try:
-            return element(value)
-        except _InvalidValueError as exc:
-            raise _InvalidValueError(f"{where}{exc}") from None
-    expected = _shape_text(shape)
-    if not isinstance(value, list):
-        raise _InvalidValueError(f"{where}expected {expected}, got {_describe(value)}")
-    if not value:
-        raise _InvalidValueError(f"{where}expected {expected}, got an empty array")
-    if shape[0] is not None and len(value) != shape[0]:
-        items = "item" if len(value) == 1 else "items"
-        raise _InvalidValueError(f"{where}expected {expected}, got {len(value)} {items}")
-    return [_nested(item, shape[1:], element, f"{index}[{i}]") for i, item in enumerate(value)]
-
-
-_Kind = _Number | _Integer | _Boolean | _Text | _Choice | _Array
-
-_LENGTH = _Number(
-    "> 0",
-    MAX_LENGTH,
-    "m",
-    smallest=MIN_PATCH_LENGTH,
-    why_smallest="m (the limit surface's arithmetic underflows)",
-)
-_MASS = _Number(">= 0", MAX_MASS, "kg")
-_FORCE = _Number(">= 0", MAX_FORCE, "N")
-_MU = _Number(
+_MASS = Number(">= 0", MAX_MASS, "kg")
+_FORCE = Number(">= 0", MAX_FORCE, "N")
+_MU = Number(
     ">= 0",
     MAX_MU,
     smallest=MIN_MU,
     why_smallest="(friction that small is rounding noise against the forces; give 0 for a "
     "frictionless contact)",
 )
-_TEXT = _Text()
-_NAME = _Text(name=True)
-_BOOLEAN = _Boolean()
-_FACETS = _Integer(3, MAX_FACETS)
-_MODEL = _Choice(MODEL_NAMES)
-_POSITION = _Array((3,), _Number("", MAX_LENGTH, "m"))
-_FORCE_VECTOR = _Array((3,), _Number("", MAX_FORCE, "N"))
-_TORQUE_VECTOR = _Array((3,), _Number("", MAX_TORQUE, "N m"))
-_GRAVITY = _Array((3,), _Number("", MAX_ACCELERATION, "m/s^2"))
-_DIRECTION = _Array((3,))
-_COORDINATES = _Array((None,), _Number("", MAX_LENGTH, "m"), MAX_GRID_CELLS)
-_RELATIVE = _Number("", MAX_RELATIVE_VALUE)
-_WEIGHTS = _Array((None,), _RELATIVE, MAX_POINTS)
-_VERTICES = _Array((None, 2), _Number("", MAX_LENGTH, "m"), MAX_POLYGON_VERTICES)
-_POINTS = _Array((None, 2), _Number("", MAX_LENGTH, "m"), MAX_POINTS)
-_ROWS = _Array((None, None), _RELATIVE, MAX_GRID_CELLS)
-
-
-@dataclass(slots=True)
-class _Table:
-    """A TOML table being read: its contents, its key path and the issue list it reports to."""
-
-    data: dict
-    path: str
-    issues: list[Issue]
-
-    def key_path(self, key: str) -> str:
-        return f"{self.path}.{_key_text(key)}" if self.path else _key_text(key)
-
-    def report(self, key: str | None, message: str) -> None:
-        """Record an issue at ``key`` (``None``: the table itself)."""
-        where = self.path if key is None else self.key_path(key)
-        self.issues.append(Issue(key_path=where, message=message))
-
-    def check_keys(self, allowed: Sequence[str]) -> None:
-        for key in self.data:
-            if key not in allowed:
-                close = _suggestion(key, allowed)
-                hint = (
-                    f"did you mean {close!r}?" if close else "allowed keys: " + ", ".join(allowed)
-                )
-                self.report(key, f"unknown key; {hint}")
-
-    def get(self, key: str, kind: _Kind, *, required: bool = False, default: object = None):
-        """The value at ``key`` converted by ``kind``; ``default`` if missing, ``None`` if
-        invalid."""
-        if key not in self.data:
-            if required:
-                self.report(key, f"missing required key; expected {kind.expected}")
-            return default
-        try:
-            return kind(self.data[key])
-        except _InvalidValueError as exc:
-            self.report(key, str(exc))
-            return None
-
-    def direction(self, key: str, *, required: bool = False) -> list[float] | None:
-        """A nonzero 3-vector at ``key``."""
-        vector = self.get(key, _DIRECTION, required=required)
-        if vector is not None and not any(vector):
-            self.report(key, "expected a direction, got the zero vector")
-            return None
-        return vector
-
-    def table(self, key: str, *, required: bool = False) -> _Table | None:
-        if key not in self.data:
-            if required:
-                self.report(key, f"missing required table; add a [{key}] section")
-            return None
-        value = self.data[key]
-        if not isinstance(value, dict):
-            self.report(key, f"expected a table, got {_describe(value)}")
-            return None
-        return _Table(value, self.key_path(key), self.issues)
-
-    def tables(self, key: str) -> list[_Table]:
-        """The required, non-empty array of tables at ``key`` (only its valid items)."""
-        value = self.data.get(key)
-        if value is None:
-            self.report(key, f"missing required key; add at least one [[{key}]] table")
-            return []
-        if not isinstance(value, list):
-            self.report(key, f"expected an array of tables ([[{key}]]), got {_describe(value)}")
-            return []
-        if not value:
-            self.report(key, f"expected at least one [[{key}]] table, got an empty array")
-        items = []
-        for index, item in enumerate(value):
-            where = f"{self.key_path(key)}[{index}]"
-            if isinstance(item, dict):
-                items.append(_Table(item, where, self.issues))
-            else:
-                self.issues.append(
-                    Issue(key_path=where, message=f"expected a table, got {_describe(item)}")
-                )
-        return items
+_TEXT = Text()
+_NAME = Text(name=True)
+_BOOLEAN = Boolean()
+_FACETS = Integer(3, MAX_FACETS)
+_MODEL = Choice(MODEL_NAMES)
+_POSITION = Array((3,), Number("", MAX_LENGTH, "m"))
+_FORCE_VECTOR = Array((3,), Number("", MAX_FORCE, "N"))
+_TORQUE_VECTOR = Array((3,), Number("", MAX_TORQUE, "N m"))
+_GRAVITY = Array((3,), Number("", MAX_ACCELERATION, "m/s^2"))
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -682,11 +286,6 @@ class _Defaults:
 
     values: dict = field(default_factory=dict)
     keys: frozenset = frozenset()
-
-
-def _given(**values: object) -> dict:
-    """The keyword arguments that are not ``None``."""
-    return {key: value for key, value in values.items() if value is not None}
 
 
 class _Reader:
@@ -699,26 +298,26 @@ class _Reader:
 
     def document(self, data: dict) -> tuple[str | None, str | None, Problem | None]:
         """The file's name, kind and problem (``None`` where invalid)."""
-        top = _Table(data, "", self.issues)
+        top = Table(data, "", self.issues)
         top.check_keys(_TOP_KEYS)
-        _check_schema_version(top)
+        check_schema_version(top)
         name = top.get("name", _NAME, required=True)
-        kind = top.get("kind", _Choice(KINDS), required=True)
-        objective = top.get("objective", _Choice(OBJECTIVES), required=True)
+        kind = top.get("kind", Choice(KINDS), required=True)
+        objective = top.get("objective", Choice(OBJECTIVES), required=True)
         if "description" in data and not isinstance(data["description"], str):
-            top.report("description", f"expected a string, got {_describe(data['description'])}")
+            top.report("description", f"expected a string, got {describe(data['description'])}")
         defaults = self._defaults(top.table("defaults"))
         body = self._body(top.table("body", required=True))
         contact_tables = top.tables("contacts")
         contacts = [self._contact(table, defaults) for table in contact_tables]
-        _check_unique_names(contact_tables, "contact")
+        check_unique_names(contact_tables, "contact")
         load_tables = top.tables("loads")
         loads = [self._load(table) for table in load_tables]
-        _check_unique_names(load_tables, "load")
+        check_unique_names(load_tables, "load")
         if self.issues:
             return name, kind, None
         # Only the objective's demands on the contacts are left for Problem to find.
-        problem = _build(
+        problem = build(
             top,
             Problem,
             key="objective",
@@ -729,7 +328,7 @@ class _Reader:
         )
         return name, kind, problem
 
-    def _defaults(self, table: _Table | None) -> _Defaults:
+    def _defaults(self, table: Table | None) -> _Defaults:
         if table is None:
             return _Defaults()
         table.check_keys(_DEFAULT_KEYS)
@@ -740,7 +339,7 @@ class _Reader:
             keys=frozenset(table.data),
         )
 
-    def _body(self, table: _Table | None) -> Body | None:
+    def _body(self, table: Table | None) -> Body | None:
         if table is None:
             return None
         start = len(self.issues)
@@ -750,9 +349,9 @@ class _Reader:
         gravity = table.get("gravity", _GRAVITY)
         if len(self.issues) > start:
             return None
-        return _build(table, Body, mass=mass, center_of_mass=center, **_given(gravity=gravity))
+        return build(table, Body, mass=mass, center_of_mass=center, **given(gravity=gravity))
 
-    def _load(self, table: _Table) -> Load | None:
+    def _load(self, table: Table) -> Load | None:
         start = len(self.issues)
         table.check_keys(_LOAD_KEYS)
         name = table.get("name", _NAME, required=True)
@@ -761,13 +360,13 @@ class _Reader:
         torque = table.get("torque", _TORQUE_VECTOR)
         if len(self.issues) > start:
             return None
-        return _build(table, Load, name=name, force=force, point=point, **_given(torque=torque))
+        return build(table, Load, name=name, force=force, point=point, **given(torque=torque))
 
-    def _contact(self, table: _Table, defaults: _Defaults) -> Contact | None:
+    def _contact(self, table: Table, defaults: _Defaults) -> Contact | None:
         start = len(self.issues)
         table.check_keys(_CONTACT_KEYS)
         name = table.get("name", _NAME, required=True)
-        role = table.get("role", _Choice(ROLES), required=True)
+        role = table.get("role", Choice(ROLES), required=True)
         position = table.get("position", _POSITION, required=True)
         normal = _normal(table)
         mu = _with_default(table, "mu", _MU, defaults, required=True)
@@ -777,7 +376,7 @@ class _Reader:
             model = POINT_VERSION[self.model]  # an override keeps point contacts point contacts
         facets = self._pyramid_option(table, "facets", _FACETS, defaults, model)
         inscribed = self._pyramid_option(table, "inscribed", _BOOLEAN, defaults, model)
-        patch, patch_axis = self._patch(table)
+        patch, patch_axis = read_patch(table, folder=self.folder)
         if model == "exact" and patch is not None:
             _check_exact_size(table, patch)
         if model in AREA_MODEL_NAMES and "patch" not in table.data:
@@ -787,7 +386,7 @@ class _Reader:
         required = (name, role, position, normal, mu, model)
         if len(self.issues) > start or None in required:
             return None
-        return _build(
+        return build(
             table,
             Contact,
             name=name,
@@ -805,7 +404,7 @@ class _Reader:
         )
 
     def _pyramid_option(
-        self, table: _Table, key: str, kind: _Kind, defaults: _Defaults, model: str | None
+        self, table: Table, key: str, kind: Kind, defaults: _Defaults, model: str | None
     ):
         """``facets`` or ``inscribed``: only for pyramid models; dropped by a non-pyramid
         override."""
@@ -823,7 +422,7 @@ class _Reader:
             )
         return None
 
-    def _report_missing_patch(self, table: _Table, model: str, name: str | None) -> None:
+    def _report_missing_patch(self, table: Table, model: str, name: str | None) -> None:
         source = f"model {model!r}" if self.model is None else f"the model override {model!r}"
         contact = f"contact {name!r}" if name else "this contact"
         table.report(
@@ -832,40 +431,8 @@ class _Reader:
             "'point-cone' or 'point-pyramid'",
         )
 
-    def _patch(self, contact: _Table) -> tuple[pressure.PressureField | None, list | None]:
-        """The contact's pressure field and its rectangle's ``axis`` (``None`` where absent)."""
-        patch = contact.table("patch")
-        if patch is None:
-            return None, None
-        shape = patch.get("shape", _Choice(PATCH_SHAPES), required=True)
-        if shape is None:
-            return None, None
-        patch.check_keys(_PATCH_KEYS[shape])
-        axis = patch.direction("axis") if shape == "rectangle" else None
-        start = len(self.issues)
-        readers = {
-            "disk": _disk,
-            "rectangle": _rectangle,
-            "polygon": _polygon,
-            "points": _points,
-            "grid": functools.partial(_grid, folder=self.folder),
-        }
-        build = readers[shape](patch)
-        if build is None or len(self.issues) > start:
-            return None, axis
-        return _build(patch, build), axis
 
-
-def _build(table: _Table, constructor: Callable, *, key: str | None = None, **arguments: object):
-    """``constructor(**arguments)``; its error becomes an issue at ``table`` (or its ``key``)."""
-    try:
-        return constructor(**arguments)
-    except FixplanError as exc:
-        table.report(key, str(exc))
-        return None
-
-
-def _check_exact_size(table: _Table, patch: pressure.PressureField) -> None:
+def _check_exact_size(table: Table, patch: pressure.PressureField) -> None:
     """Report a patch too fine for the planner's exact model (its cost grows with the number
     of friction disks)."""
     disks = len(patch.quadrature(PLANNER_EXACT_ORDER)[0])
@@ -878,19 +445,7 @@ def _check_exact_size(table: _Table, patch: pressure.PressureField) -> None:
         )
 
 
-def _check_schema_version(top: _Table) -> None:
-    version = top.data.get("schema_version")
-    if version is None:
-        top.report("schema_version", f"missing required key; expected {SCHEMA_VERSION}")
-    elif isinstance(version, bool) or version != SCHEMA_VERSION:
-        top.report(
-            "schema_version",
-            f"expected {SCHEMA_VERSION} (the only schema version this fixplan reads), got "
-            f"{_describe(version)}",
-        )
-
-
-def _with_default(table: _Table, key: str, kind: _Kind, defaults: _Defaults, *, required: bool):
+def _with_default(table: Table, key: str, kind: Kind, defaults: _Defaults, *, required: bool):
     """The contact's ``key``, else ``[defaults]``'s; reports it missing from both if required."""
     if key in table.data:
         return table.get(key, kind)
@@ -901,7 +456,7 @@ def _with_default(table: _Table, key: str, kind: _Kind, defaults: _Defaults, *, 
     return None
 
 
-def _normal(table: _Table) -> list[float] | None:
+def _normal(table: Table) -> list[float] | None:
     normal = table.direction("normal", required=True)
     if normal is None:
         return None
@@ -917,7 +472,7 @@ def _normal(table: _Table) -> list[float] | None:
     return normal
 
 
-def _contact_axis(table: _Table, patch_axis: list | None) -> list | None:
+def _contact_axis(table: Table, patch_axis: list | None) -> list | None:
     """The contact's ``axis``, else its rectangle patch's; reports the two if they differ."""
     axis = table.direction("axis")
     if "axis" not in table.data:
@@ -933,7 +488,7 @@ def _contact_axis(table: _Table, patch_axis: list | None) -> list | None:
     return axis
 
 
-def _active_force(table: _Table, key: str, role: str | None) -> float | None:
+def _active_force(table: Table, key: str, role: str | None) -> float | None:
     if key not in table.data:
         return None
     if role in PASSIVE_ROLES:
@@ -944,134 +499,6 @@ def _active_force(table: _Table, key: str, role: str | None) -> float | None:
         )
         return None
     return table.get(key, _FORCE)
-
-
-def _disk(patch: _Table) -> Callable | None:
-    radius = patch.get("radius", _LENGTH, required=True)
-    profile = patch.get("pressure", _Choice(pressure.DISK_PROFILES), default="uniform")
-    inner = patch.get("inner_radius", _LENGTH)
-    if profile == "annulus" and "inner_radius" not in patch.data:
-        patch.report("inner_radius", "missing: pressure 'annulus' needs inner_radius < radius [m]")
-    elif profile not in (None, "annulus") and "inner_radius" in patch.data:
-        patch.report("inner_radius", f"only for pressure 'annulus', not {profile!r}; remove it")
-    return functools.partial(pressure.disk, radius, profile, inner_radius=inner)
-
-
-def _rectangle(patch: _Table) -> Callable | None:
-    length = patch.get("length", _LENGTH, required=True)
-    width = patch.get("width", _LENGTH, required=True)
-    profile = patch.data.get("pressure", "uniform")
-    if profile != "uniform":
-        patch.report(
-            "pressure",
-            f"expected 'uniform' (the only pressure of a rectangle), got {_describe(profile)}; "
-            "use a grid for other pressure maps",
-        )
-    if length is not None and width is not None:
-        ratio = max(length, width) / min(length, width)
-        if ratio > MAX_ASPECT_RATIO:
-            patch.report(
-                "width",
-                f"the sides' ratio {ratio:.3g} exceeds the {MAX_ASPECT_RATIO:g} accepted; model "
-                "so thin a strip as points along a line or widen it",
-            )
-    return functools.partial(pressure.rectangle, length, width)
-
-
-def _polygon(patch: _Table) -> Callable | None:
-    vertices = patch.get("vertices", _VERTICES, required=True)
-    return functools.partial(pressure.polygon, vertices)
-
-
-def _points(patch: _Table) -> Callable | None:
-    xy = patch.get("xy", _POINTS, required=True)
-    weights = patch.get("weights", _WEIGHTS)
-    return functools.partial(pressure.points, xy, weights)
-
-
-def _grid(patch: _Table, *, folder: Path) -> Callable | None:
-    x = patch.get("x", _COORDINATES, required=True)
-    y = patch.get("y", _COORDINATES, required=True)
-    values = patch.data.get("values")
-    try:
-        if isinstance(values, str):
-            rows = _csv_rows(folder / values)
-        elif isinstance(values, list):
-            rows = _ROWS(values)
-        else:
-            got = "nothing" if values is None else _describe(values)
-            raise _InvalidValueError(
-                f"expected {_ROWS.expected} (one row per y) or the name of a CSV file, got {got}"
-            )
-        if x is not None and y is not None:
-            _check_grid_shape(rows, len(x), len(y))
-    except _InvalidValueError as exc:
-        patch.report("values", str(exc))
-        return None
-    return functools.partial(pressure.grid, x, y, rows)
-
-
-def _check_grid_shape(rows: list[list[float]], nx: int, ny: int) -> None:
-    if nx * ny > MAX_GRID_CELLS:
-        raise _InvalidValueError(
-            f"a grid of {nx} by {ny} cells; at most {MAX_GRID_CELLS} cells are accepted"
-        )
-    if len(rows) != ny:
-        raise _InvalidValueError(f"expected {ny} rows (one per y), got {len(rows)}")
-    for index, row in enumerate(rows):
-        if len(row) != nx:
-            raise _InvalidValueError(
-                f"row {index}: expected {nx} values (one per x), got {len(row)}"
-            )
-
-
-def _csv_rows(file: Path) -> list[list[float]]:
-    """The numbers of a CSV file, one list per non-blank row.
-
-    A byte-order mark and empty cells at the end of a row (a trailing comma), which tactile
-    array software often writes, are ignored.
-    """
-    try:
-        text = _read_regular_file(file, MAX_FILE_BYTES).decode("utf-8-sig")
-    except (_InvalidValueError, UnicodeDecodeError) as exc:
-        reason = str(exc) if isinstance(exc, _InvalidValueError) else "not UTF-8 text"
-        name = _SHORT.repr(str(file))
-        raise _InvalidValueError(f"cannot read the CSV file {name}: {reason}") from None
-    rows = []
-    reader = csv.reader(text.replace("\0", "\ufffd").splitlines())
-    for row in reader:
-        if not any(cell.strip() for cell in row):
-            continue
-        while not row[-1].strip():
-            row = row[:-1]
-        numbers = []
-        for column, cell in enumerate(row, start=1):
-            where = f"{file.name} line {reader.line_num}, column {column}"
-            try:
-                numbers.append(_RELATIVE(float(cell)))
-            except ValueError:
-                raise _InvalidValueError(
-                    f"{where}: expected a finite number, got {_SHORT.repr(cell.strip())}"
-                ) from None
-            except _InvalidValueError as exc:
-                raise _InvalidValueError(f"{where}: {exc}") from None
-        rows.append(numbers)
-    if not rows:
-        raise _InvalidValueError(f"{file.name} holds no numbers")
-    return rows
-
-
-def _check_unique_names(tables: list[_Table], noun: str) -> None:
-    """Report every table whose ``name`` an earlier table already uses."""
-    first: dict[str, str] = {}
-    for table in tables:
-        name = table.data.get("name")
-        if not isinstance(name, str):
-            continue
-        if name in first:
-            table.report("name", f"duplicate {noun} name {name!r}; {first[name]} already uses it")
-        else:
-            first[name] = table.path
 
 
 __all__ = ["Issue", "ProblemFile", "ProblemFileError", "check_problem", "load_problem"]
