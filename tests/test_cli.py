@@ -272,7 +272,7 @@ def test_a_report_that_fails_midway_leaves_nothing_behind(tmp_path, capsys, monk
     def broken(*args):
         raise report_module.ReportError("cannot write: disk full")
 
-    monkeypatch.setattr(report_module, "_to_html", broken)
+    monkeypatch.setattr(report_module, "to_html", broken)
     report = tmp_path / "out" / "report"
     assert main(["plan", str(write(tmp_path)), "--report", str(report)]) == EXIT_INVALID_INPUT
     assert "disk full" in capsys.readouterr().err

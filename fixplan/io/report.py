@@ -17,15 +17,11 @@ so two reports of the same problem file and plan are byte-identical and diff cle
 
 from __future__ import annotations
 
-import contextlib
-import html
 import json
 import os
 import re
-import shutil
-import uuid
 import warnings
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
@@ -37,6 +33,20 @@ import fixplan
 from fixplan.errors import FixplanError, InvalidArgumentError
 from fixplan.io import figures
 from fixplan.io.problem_file import ProblemFile
+from fixplan.io.report_document import (
+    Block,
+    Code,
+    Heading,
+    Image,
+    List,
+    Paragraph,
+    Table,
+    Writer,
+    inline,
+    staged_folder,
+    to_html,
+    to_markdown,
+)
 from fixplan.planner.contact_surface import COMPONENTS, ContactSetSurface
 from fixplan.planner.plan import Plan
 from fixplan.planner.planner import Planner
@@ -58,154 +68,6 @@ SLUG_LENGTH = 40
 RESIDUAL_FLOOR = 1e-12
 
 _SOLVER_PACKAGES = {"CLARABEL": "clarabel", "OSQP": "osqp", "SCS": "scs"}
-_MARKDOWN_SPECIAL = re.compile(r"([\\`*_<>|])")
-_MARKDOWN_LINK = re.compile(r"([\[\]])")
-_CSS = """\
-body { font-family: sans-serif; max-width: 70em; margin: 2em auto; padding: 0 1em; color: #222; }
-table { border-collapse: collapse; margin: 0.5em 0 1em; }
-th, td { border: 1px solid #bbb; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }
-th { background: #eee; }
-code { font-size: 0.9em; background: #f4f4f4; padding: 0 0.2em; }
-figure { margin: 1em 0; }
-figure img { max-width: 100%; border: 1px solid #ddd; }
-figcaption { font-size: 0.9em; color: #444; }
-"""
-
-
-class ReportError(FixplanError, OSError):
-    """The report folder cannot be created or written."""
-
-
-# -- document blocks ----------------------------------------------------------------------------
-
-
-@dataclass(frozen=True, slots=True)
-class _Code:
-    """Inline code (verbatim text)."""
-
-    text: str
-
-
-#: Inline text: plain strings and code spans.
-_Inline = tuple[str | _Code, ...]
-
-
-@dataclass(frozen=True, slots=True)
-class _Heading:
-    level: int
-    text: _Inline
-
-
-@dataclass(frozen=True, slots=True)
-class _Paragraph:
-    text: _Inline
-
-
-@dataclass(frozen=True, slots=True)
-class _Table:
-    header: tuple[str, ...]
-    rows: tuple[tuple[_Inline, ...], ...]
-
-
-@dataclass(frozen=True, slots=True)
-class _List:
-    items: tuple[_Inline, ...]
-
-
-@dataclass(frozen=True, slots=True)
-class _Image:
-    file: str
-    alt: str
-    caption: _Inline
-
-
-_Block = _Heading | _Paragraph | _Table | _List | _Image
-
-
-def _text(*parts: str | _Code) -> _Inline:
-    return tuple(parts)
-
-
-def _markdown_inline(text: _Inline, *, in_table: bool = False) -> str:
-    """Markdown of ``text``; in a table cell ``|`` is escaped inside code spans too (GFM)."""
-    out = []
-    for part in text:
-        if isinstance(part, _Code):
-            body = part.text.replace("|", "\\|") if in_table else part.text
-            fence, pad = ("``", " ") if "`" in body else ("`", "")
-            out.append(f"{fence}{pad}{body}{pad}{fence}")
-        else:
-            out.append(_markdown_escape(part))
-    return "".join(out).replace("\n", " ")
-
-
-def _markdown_escape(text: str) -> str:
-    """``text`` with Markdown's emphasis, code, HTML and table characters escaped; brackets only
-    where they could form a link (so units read ``[N]``)."""
-    text = _MARKDOWN_SPECIAL.sub(r"\\\1", text)
-    return _MARKDOWN_LINK.sub(r"\\\1", text) if "](" in text else text
-
-
-def _html_inline(text: _Inline) -> str:
-    return "".join(
-        f"<code>{html.escape(p.text)}</code>" if isinstance(p, _Code) else html.escape(p)
-        for p in text
-    )
-
-
-def _to_markdown(blocks: Sequence[_Block]) -> str:
-    chunks = []
-    for block in blocks:
-        if isinstance(block, _Heading):
-            chunks.append("#" * block.level + " " + _markdown_inline(block.text))
-        elif isinstance(block, _Paragraph):
-            chunks.append(_markdown_inline(block.text))
-        elif isinstance(block, _List):
-            chunks.append("\n".join("- " + _markdown_inline(item) for item in block.items))
-        elif isinstance(block, _Table):
-            header = [_markdown_inline((h,), in_table=True) for h in block.header]
-            lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-            for row in block.rows:
-                cells = [_markdown_inline(cell, in_table=True) for cell in row]
-                lines.append("| " + " | ".join(cells) + " |")
-            chunks.append("\n".join(lines))
-        else:
-            alt = _MARKDOWN_LINK.sub(r"\\\1", _markdown_escape(block.alt))
-            chunks.append(f"![{alt}]({block.file})\n\n{_markdown_inline(block.caption)}")
-    return "\n\n".join(chunks) + "\n"
-
-
-def _to_html(blocks: Sequence[_Block], title: str) -> str:
-    body = []
-    for block in blocks:
-        if isinstance(block, _Heading):
-            level = block.level
-            body.append(f"<h{level}>{_html_inline(block.text)}</h{level}>")
-        elif isinstance(block, _Paragraph):
-            body.append(f"<p>{_html_inline(block.text)}</p>")
-        elif isinstance(block, _List):
-            items = "".join(f"<li>{_html_inline(item)}</li>" for item in block.items)
-            body.append(f"<ul>{items}</ul>")
-        elif isinstance(block, _Table):
-            header = "".join(f"<th>{html.escape(h)}</th>" for h in block.header)
-            rows = "\n".join(
-                "<tr>" + "".join(f"<td>{_html_inline(cell)}</td>" for cell in row) + "</tr>"
-                for row in block.rows
-            )
-            body.append(
-                f"<table>\n<thead><tr>{header}</tr></thead>\n<tbody>\n{rows}\n</tbody>\n</table>"
-            )
-        else:
-            body.append(
-                f'<figure><img src="{html.escape(block.file)}" alt="{html.escape(block.alt)}">'
-                f"<figcaption>{_html_inline(block.caption)}</figcaption></figure>"
-            )
-    return (
-        '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
-        f"<title>{html.escape(title)}</title>\n<style>\n{_CSS}</style>\n</head>\n<body>\n"
-        + "\n".join(body)
-        + "\n</body>\n</html>\n"
-    )
 
 
 # -- numbers and names --------------------------------------------------------------------------
@@ -277,30 +139,6 @@ class _Figure:
     file: str
     alt: str
     caption: str
-
-
-class _Writer:
-    """Writes the files of one report and keeps the list of what it wrote."""
-
-    def __init__(self, directory: Path):
-        self.directory = directory
-        self.written: list[Path] = []
-
-    def write(self, name: str, content: bytes) -> None:
-        path = self.directory / name
-        try:
-            path.write_bytes(content)
-        except OSError as exc:
-            raise ReportError(f"cannot write {path}: {exc.strerror or exc}") from exc
-        self.written.append(path)
-
-    def figure(self, name: str, draw: Callable[[], object]) -> None:
-        path = self.directory / name
-        try:
-            figures.save_png(draw(), path)
-        except OSError as exc:
-            raise ReportError(f"cannot write {path}: {exc.strerror or exc}") from exc
-        self.written.append(path)
 
 
 def _state_text(plan: Plan) -> str:
@@ -404,60 +242,60 @@ def _draw_figures(problem, plan, planner, load, subspace, writer) -> tuple[list,
 # -- the document -------------------------------------------------------------------------------
 
 
-def _header(problem_file: ProblemFile, plan: Plan, planner: Planner, subspace) -> list[_Block]:
+def _header(problem_file: ProblemFile, plan: Plan, planner: Planner, subspace) -> list[Block]:
     rows = [
-        ("fixplan", _text(fixplan.__version__)),
-        ("cvxpy", _text(cvxpy.__version__)),
-        ("solver requested", _text(_solver_text(planner.solver))),
-        ("solver used", _text(_solver_text(plan.solver) or "none")),
-        ("problem", _text(problem_file.name)),
-        ("kind", _text(problem_file.kind)),
-        ("problem file", _text(_Code(problem_file.path.name))),
-        ("problem file SHA-256", _text(_Code(problem_file.sha256))),
-        ("model override", _text(problem_file.model_override or "none")),
-        ("objective", _text(plan.objective)),
-        ("sliding subspace", _text(", ".join(subspace))),
+        ("fixplan", inline(fixplan.__version__)),
+        ("cvxpy", inline(cvxpy.__version__)),
+        ("solver requested", inline(_solver_text(planner.solver))),
+        ("solver used", inline(_solver_text(plan.solver) or "none")),
+        ("problem", inline(problem_file.name)),
+        ("kind", inline(problem_file.kind)),
+        ("problem file", inline(Code(problem_file.path.name))),
+        ("problem file SHA-256", inline(Code(problem_file.sha256))),
+        ("model override", inline(problem_file.model_override or "none")),
+        ("objective", inline(plan.objective)),
+        ("sliding subspace", inline(", ".join(subspace))),
     ]
     models = [
-        (_text(c.name), _text(c.role), _text(_Code(repr(m))))
+        (inline(c.name), inline(c.role), inline(Code(repr(m))))
         for c, m in zip(planner.problem.contacts, planner.models, strict=True)
     ]
     return [
-        _Heading(1, _text(f"fixplan report: {problem_file.name}")),
-        _Table(("item", "value"), tuple((_text(k), v) for k, v in rows)),
-        _Heading(2, _text("Friction models")),
-        _Paragraph(_text("The model of every contact at unit normal force.")),
-        _Table(("contact", "role", "model"), tuple(models)),
+        Heading(1, inline(f"fixplan report: {problem_file.name}")),
+        Table(("item", "value"), tuple((inline(k), v) for k, v in rows)),
+        Heading(2, inline("Friction models")),
+        Paragraph(inline("The model of every contact at unit normal force.")),
+        Table(("contact", "role", "model"), tuple(models)),
     ]
 
 
-def _result(plan: Plan, problem: Problem) -> list[_Block]:
+def _result(plan: Plan, problem: Problem) -> list[Block]:
     unit = " (safety factor)" if plan.objective in FIXED_FORCE_OBJECTIVES else " N"
     value = "none" if plan.objective_value is None else _num(plan.objective_value) + unit
-    blocks: list[_Block] = [
-        _Heading(2, _text("Result")),
-        _Table(
+    blocks: list[Block] = [
+        Heading(2, inline("Result")),
+        Table(
             ("item", "value"),
             (
-                (_text("status"), _text(plan.status)),
-                (_text("objective value"), _text(value)),
-                (_text("equilibrium residual (relative)"), _text(_residual(plan.residual))),
+                (inline("status"), inline(plan.status)),
+                (inline("objective value"), inline(value)),
+                (inline("equilibrium residual (relative)"), inline(_residual(plan.residual))),
             ),
         ),
     ]
     if plan.warnings:
-        blocks += [_Paragraph(_text("Warnings:")), _List(tuple(_text(w) for w in plan.warnings))]
+        blocks += [Paragraph(inline("Warnings:")), List(tuple(inline(w) for w in plan.warnings))]
     if plan.certificate is not None:
         blocks += [
-            _Heading(2, _text("Infeasibility certificate")),
-            _Paragraph(_text(plan.certificate)),
+            Heading(2, inline("Infeasibility certificate")),
+            Paragraph(inline(plan.certificate)),
         ]
         if plan.infeasible_motions:
             blocks.append(
-                _Table(
+                Table(
                     ("load case", "unresisted motion"),
                     tuple(
-                        (_text(name), _text(m.describe()))
+                        (inline(name), inline(m.describe()))
                         for name, m in plan.infeasible_motions.items()
                     ),
                 )
@@ -472,34 +310,34 @@ def _result(plan: Plan, problem: Problem) -> list[_Block]:
                 text = ", ".join(
                     f"{case}: {_num(f)}" for case, f in zip(plan.load_names, force, strict=True)
                 )
-            rows.append((_text(name), _text(roles[name]), _text(text)))
+            rows.append((inline(name), inline(roles[name]), inline(text)))
         blocks += [
-            _Heading(2, _text("Active forces")),
-            _Table(("contact", "role", "normal force [N]"), tuple(rows)),
+            Heading(2, inline("Active forces")),
+            Table(("contact", "role", "normal force [N]"), tuple(rows)),
         ]
     if plan.safety_factors:
         rows = tuple(
             (
-                _text(name),
-                _text(_num(s)),
-                _text("yes" if plan.held.get(name) else "no"),
-                _text(plan.describe_held(name)),
+                inline(name),
+                inline(_num(s)),
+                inline("yes" if plan.held.get(name) else "no"),
+                inline(plan.describe_held(name)),
             )
             for name, s in plan.safety_factors.items()
         )
         blocks += [
-            _Heading(2, _text("Safety factors")),
-            _Paragraph(
-                _text(
+            Heading(2, inline("Safety factors")),
+            Paragraph(
+                inline(
                     "The largest factor by which each task load (not gravity) can be scaled "
                     "while the contacts hold it with these active forces, and the interval of "
                     "multiples held: it starts above 0 where the active forces and the weight "
                     "alone push the part out."
                 )
             ),
-            _Table(("load case", "safety factor", "held", "multiples held"), rows),
-            _Paragraph(
-                _text(
+            Table(("load case", "safety factor", "held", "multiples held"), rows),
+            Paragraph(
+                inline(
                     f"Critical load case: {plan.critical_load}; its most used contact: "
                     f"{plan.critical_contact}."
                 )
@@ -507,18 +345,18 @@ def _result(plan: Plan, problem: Problem) -> list[_Block]:
         ]
     if plan.motions:
         rows = tuple(
-            (_text(name), _text("no limit found" if m is None else m.describe()))
+            (inline(name), inline("no limit found" if m is None else m.describe()))
             for name, m in plan.motions.items()
         )
         blocks += [
-            _Heading(2, _text("Impending motion")),
-            _Paragraph(_text("How the body starts to slide when a task load exceeds its margin.")),
-            _Table(("load case", "motion"), rows),
+            Heading(2, inline("Impending motion")),
+            Paragraph(inline("How the body starts to slide when a task load exceeds its margin.")),
+            Table(("load case", "motion"), rows),
         ]
     return blocks
 
 
-def _wrench_table(plan: Plan, j: int, length_scale: float) -> list[_Block]:
+def _wrench_table(plan: Plan, j: int, length_scale: float) -> list[Block]:
     wrenches = plan.contact_wrenches[:, j]
     noise = PRINT_RTOL * float(np.max(np.abs(wrenches[:, 0])))
     wrenches = np.where(
@@ -528,12 +366,14 @@ def _wrench_table(plan: Plan, j: int, length_scale: float) -> list[_Block]:
     for i, name in enumerate(plan.contact_names):
         fn, ft1, ft2, mn = wrenches[i]
         used = "n/a" if plan.utilisation is None else _num(plan.utilisation[i, j], 3)
-        rows.append(tuple(_text(x) for x in (name, _num(fn), _num(ft1), _num(ft2), _num(mn), used)))
+        rows.append(
+            tuple(inline(x) for x in (name, _num(fn), _num(ft1), _num(ft2), _num(mn), used))
+        )
     load = plan.load_names[j]
     return [
-        _Heading(2, _text(f"Contact wrenches, load case {load}")),
-        _Paragraph(
-            _text(
+        Heading(2, inline(f"Contact wrenches, load case {load}")),
+        Paragraph(
+            inline(
                 f"Each contact's wrench on the body in its own frame (normal, tangents t1, t2, "
                 f"moment about the normal), {_state_text(plan)}. Friction used: the fraction of "
                 "the contact's friction set its load uses at impending slip."
@@ -545,7 +385,7 @@ def _wrench_table(plan: Plan, j: int, length_scale: float) -> list[_Block]:
                 )
             )
         ),
-        _Table(
+        Table(
             ("contact", "fn [N]", "ft1 [N]", "ft2 [N]", "mn [N m]", "friction used"), tuple(rows)
         ),
     ]
@@ -614,39 +454,13 @@ def write_report(
             f"{', '.join(COMPONENTS)}; got {list(subspace)}"
         )
     directory = Path(directory)
-    with _staging(directory) as staging:
-        writer = _Writer(staging)
+    with staged_folder(directory) as staging:
+        writer = Writer(staging)
         _write_files(writer, problem_file, plan, planner, subspace)
     return [directory / path.name for path in writer.written]
 
 
-@contextlib.contextmanager
-def _staging(directory: Path) -> Iterator[Path]:
-    """A temporary folder for the files of the report folder ``directory``; on success its
-    files are moved there (the folder is created), on failure it is removed."""
-    if directory.is_file():
-        raise ReportError(f"cannot write the report folder {directory}: a file has its name")
-    try:
-        parent = next(p for p in directory.absolute().parents if p.exists())
-        staging = parent / f".{directory.name[:40]}.partial-{uuid.uuid4().hex[:12]}"
-        staging.mkdir()
-    except (OSError, ValueError) as exc:
-        raise ReportError(f"cannot create the report folder {directory}: {exc}") from exc
-    try:
-        yield staging
-        if directory.is_dir():
-            for path in staging.iterdir():
-                os.replace(path, directory / path.name)
-        else:
-            directory.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(staging, directory)
-    except OSError as exc:
-        raise ReportError(f"cannot write the report folder {directory}: {exc}") from exc
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
-
-
-def _write_files(writer: _Writer, problem_file: ProblemFile, plan: Plan, planner, subspace):
+def _write_files(writer: Writer, problem_file: ProblemFile, plan: Plan, planner, subspace):
     """Write every file of the report (see the module docstring) with ``writer``."""
     problem = planner.problem
     document = json.dumps(plan.as_dict(), indent=2, sort_keys=True)
@@ -656,12 +470,12 @@ def _write_files(writer: _Writer, problem_file: ProblemFile, plan: Plan, planner
     blocks = _header(problem_file, plan, planner, subspace) + _result(plan, problem)
     if plan.contact_wrenches is not None:
         blocks += _wrench_table(plan, plan.load_names.index(load), planner.length_scale)
-    blocks.append(_Heading(2, _text("Figures")))
+    blocks.append(Heading(2, inline("Figures")))
     if case_note:
-        blocks.append(_Paragraph(_text(case_note)))
-    blocks += [_Image(f.file, f.alt, _text(f.caption)) for f in drawn]
+        blocks.append(Paragraph(inline(case_note)))
+    blocks += [Image(f.file, f.alt, inline(f.caption)) for f in drawn]
     if notes:
-        blocks.append(_List(tuple(_text(note) for note in notes)))
+        blocks.append(List(tuple(inline(note) for note in notes)))
     title = f"fixplan report: {problem_file.name}"
-    writer.write("report.md", _to_markdown(blocks).encode("utf-8"))
-    writer.write("report.html", _to_html(blocks, title).encode("utf-8"))
+    writer.write("report.md", to_markdown(blocks).encode("utf-8"))
+    writer.write("report.html", to_html(blocks, title).encode("utf-8"))
