@@ -40,6 +40,7 @@ from fixplan.io.report_document import (
     Image,
     List,
     Paragraph,
+    ReportError,
     Table,
     Writer,
     inline,
@@ -479,3 +480,6 @@ def _write_files(writer: Writer, problem_file: ProblemFile, plan: Plan, planner,
     title = f"fixplan report: {problem_file.name}"
     writer.write("report.md", to_markdown(blocks).encode("utf-8"))
     writer.write("report.html", to_html(blocks, title).encode("utf-8"))
+
+
+__all__ = ["ReportError", "default_sliding_subspace", "write_report"]
