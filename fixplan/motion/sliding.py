@@ -31,9 +31,10 @@ inside the surface and start again when the load leaves it (stick–slip).
 The state is integrated by an adaptive Runge–Kutta method (scipy's ``solve_ivp``) with an event
 where the speed falls below ``STOP_RTOL`` of the run's speed scale (the larger of the starting
 speed and the speed the largest friction force takes away over the run); there the body is put
-at rest. Without a load it stays at rest; with one, the integration goes on from rest, steps
-no longer than the sample spacing (a load that leaves the surface and returns between two
-samples may go unnoticed while the body rests).
+at rest. Without a load it stays at rest. With one, the load on the resting body is checked at
+the samples, and the instant it leaves the surface is found between them by root finding; the
+body starts to slide there (a load that leaves the surface and comes back between two samples
+goes unnoticed).
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.integrate import solve_ivp
-from scipy.optimize import root
+from scipy.optimize import brentq, root
 
 from fixplan import validation
 from fixplan.errors import ConvergenceError, InvalidArgumentError
@@ -55,6 +56,12 @@ STOP_RTOL = 1e-9
 
 #: Relative tolerance of the adaptive integration.
 INTEGRATION_RTOL = 1e-10
+
+#: Absolute tolerance of the velocities, as a fraction of the stopping speed.
+STOP_ATOL = 1e-2
+
+#: The instant a resting body starts to slide is found to this fraction of the duration.
+LEAVE_XTOL = 1e-15
 
 #: Relative step tolerance of the root finding of the starting acceleration.
 START_XTOL = 1e-12
@@ -81,6 +88,8 @@ class Sliding:
         moved; ``None``: moving at the end).
     stops : tuple of float
         Every instant [s] at which the body came to rest (it may start again under a load).
+    starts : tuple of float
+        Every instant [s] at which a resting body started to slide (its load left the surface).
     """
 
     t: np.ndarray
@@ -88,6 +97,7 @@ class Sliding:
     twists: np.ndarray
     stopped: float | None
     stops: tuple[float, ...]
+    starts: tuple[float, ...]
 
 
 def slide(
@@ -144,19 +154,32 @@ def slide(
                 * duration)  # fmt: skip
 
     def stopping(t, state):
-        return body.speed(state) - STOP_RTOL * scale
+        return body.speed(state) - stop_speed
 
     stopping.terminal = True
     stopping.direction = -1
+    # Velocities to well below the stopping speed: a step that jumps across rest would
+    # otherwise bounce off it (friction reverses there) unseen by the event.
+    stop_speed = STOP_RTOL * scale
+    gyration = np.sqrt(inertia / mass)
+    atol = np.array([*[INTEGRATION_RTOL * scale * max(duration, 1.0)] * 3,
+                     *(STOP_ATOL * stop_speed / np.array([1.0, 1.0, gyration]))])  # fmt: skip
     grid = np.linspace(0.0, duration, int(samples) + 1)
-    max_step = np.inf if load is None else duration / samples
-    times, states, stops = [], [], []
+    times, states, stops, starts = [0.0], [start], [], []
     t, state = 0.0, start
-    while True:
+    while t < duration:
+        if not np.any(state[3:]):  # at rest until the load leaves the surface
+            leave = body.leaving(t, state[:3], grid)
+            rest = grid[(grid > t) & (grid <= (duration if leave is None else leave))]
+            times += list(rest)
+            states += [state] * len(rest)
+            if leave is None:
+                break
+            t = leave
+            starts.append(t)
         result = solve_ivp(
-            body.rate, (t, duration), state, t_eval=grid[grid > t] if stops else grid,
-            events=stopping, rtol=INTEGRATION_RTOL, max_step=max_step,
-            atol=INTEGRATION_RTOL * scale * max(duration, 1.0),
+            body.rate, (t, duration), state, t_eval=grid[grid > t], events=stopping,
+            rtol=INTEGRATION_RTOL, atol=atol,
         )  # fmt: skip
         times += list(result.t)
         states += list(result.y.T)
@@ -168,11 +191,6 @@ def slide(
         stops.append(t)
         times.append(t)
         states.append(state)
-        if load is None:  # nothing will move it again
-            rest = grid[grid > t]
-            times += list(rest)
-            states += [state] * len(rest)
-            break
     states = np.array(states)
     order = np.argsort(times, kind="stable")
     states = states[order]
@@ -183,6 +201,7 @@ def slide(
         twists=np.array([_rotated(-x[2], x[3:]) for x in states]),
         stopped=(stops[-1] if stops else 0.0) if resting else None,
         stops=tuple(stops),
+        starts=tuple(starts),
     )
 
 
@@ -212,11 +231,33 @@ class _Body:
         gyration = np.sqrt(self.masses[2] / self.masses[0])
         return float(np.hypot(np.hypot(state[3], state[4]), state[5] * gyration))
 
+    def applied(self, t: float, pose: np.ndarray) -> np.ndarray:
+        """The applied load [N, N, N m] at time ``t`` [s] and world pose ``pose``."""
+        if self.load is None:
+            return np.zeros(3)
+        return validation.finite_array("load(t, pose)", self.load(t, pose.copy()), shape=(3,))
+
+    def leaving(self, t: float, pose: np.ndarray, grid: np.ndarray) -> float | None:
+        """The first instant from ``t`` [s] at which the load on the body resting at ``pose``
+        leaves the surface: checked at the samples ``grid`` and found between them by
+        root finding; ``None`` if it stays inside."""
+        if self.load is None:
+            return None
+
+        def margin(time: float) -> float:
+            return float(self.friction.safety_factor(self.applied(time, pose))) - 1.0
+
+        if margin(t) < 0.0:
+            return t
+        before = t
+        for time in grid[grid > t]:
+            if margin(time) < 0.0:
+                return brentq(margin, before, time, xtol=LEAVE_XTOL * grid[-1])
+            before = time
+        return None
+
     def rate(self, t: float, state: np.ndarray) -> list[float]:
-        applied = np.zeros(3)
-        if self.load is not None:
-            pose = state[:3].copy()
-            applied = validation.finite_array("load(t, pose)", self.load(t, pose), shape=(3,))
+        applied = self.applied(t, state[:3])
         twist = _rotated(-state[2], state[3:])
         if np.any(twist):
             acceleration = (applied - np.asarray(self.friction.load(twist))) / self.masses
