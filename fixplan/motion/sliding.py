@@ -132,7 +132,8 @@ def slide(
     duration : float
         Simulated time [s], > 0.
     samples : int
-        Evenly spaced samples returned (plus the instants the body stops).
+        Evenly spaced samples returned (plus the instants the body stops; a resting body's
+        load is checked at them).
     """
     friction = forward_map(surface)
     mass = validation.positive_scalar("mass", mass)
@@ -152,6 +153,7 @@ def slide(
     start = np.concatenate([pose, _rotated(pose[2], twist)])
     scale = max(body.speed(start), float(friction.support(np.array([1.0, 0.0, 0.0]))) / mass
                 * duration)  # fmt: skip
+    stop_speed = STOP_RTOL * scale
 
     def stopping(t, state):
         return body.speed(state) - stop_speed
@@ -160,7 +162,6 @@ def slide(
     stopping.direction = -1
     # Velocities to well below the stopping speed: a step that jumps across rest would
     # otherwise bounce off it (friction reverses there) unseen by the event.
-    stop_speed = STOP_RTOL * scale
     gyration = np.sqrt(inertia / mass)
     atol = np.array([*[INTEGRATION_RTOL * scale * max(duration, 1.0)] * 3,
                      *(STOP_ATOL * stop_speed / np.array([1.0, 1.0, gyration]))])  # fmt: skip
