@@ -6,8 +6,9 @@ top-level modules.
 """
 
 from fixplan.motion.outline import Outline
+from fixplan.motion.pivoting import Settling, settle
 from fixplan.motion.pushing import MotionCone, PushStep, motion_cone, push_step
-from fixplan.motion.sliding import Sliding, slide
+from fixplan.motion.sliding import Sliding, slide, start_acceleration
 from fixplan.motion.trajectory import PointPusher, Trajectory, push
 
 __all__ = [
@@ -15,10 +16,13 @@ __all__ = [
     "Outline",
     "PointPusher",
     "PushStep",
+    "Settling",
     "Sliding",
     "Trajectory",
     "motion_cone",
     "push",
     "push_step",
+    "settle",
     "slide",
+    "start_acceleration",
 ]
