@@ -5,18 +5,23 @@ imports only from :mod:`fixplan.planner`, :mod:`fixplan.models`, :mod:`fixplan.s
 top-level modules.
 """
 
-from fixplan.motion.outline import Outline
+from fixplan.motion.line_contact import line_push_step
+from fixplan.motion.outline import FacePoints, Outline
+from fixplan.motion.pushers import LinePusher, PointPusher
 from fixplan.motion.pushing import MotionCone, PushStep, motion_cone, push_step
 from fixplan.motion.sliding import Sliding, slide
-from fixplan.motion.trajectory import PointPusher, Trajectory, push
+from fixplan.motion.trajectory import Trajectory, push
 
 __all__ = [
+    "FacePoints",
+    "LinePusher",
     "MotionCone",
     "Outline",
     "PointPusher",
     "PushStep",
     "Sliding",
     "Trajectory",
+    "line_push_step",
     "motion_cone",
     "push",
     "push_step",
