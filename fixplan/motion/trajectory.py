@@ -14,9 +14,9 @@ A flat pusher touches the lowest points of the outline within the strip its face
 another point of it reaching the face is an event: the step is cut where it comes level with
 the contact (bisection on the time within the step), and continues with both points touching —
 the part rotates onto the face without passing through it, then rides flush or rotates off as
-the mechanics say. After each integrated stretch in contact, a part that the integration's
-error has carried behind the face (by the step's local error) is moved back onto it along the
-face normal.
+the mechanics say. After each integrated stretch in which the face presses, the part is put back
+onto the face along its normal: the integration moves the contact off it by the step's local
+error (third order), which would otherwise add up to a gap or an overlap.
 """
 
 from __future__ import annotations
@@ -280,8 +280,8 @@ class _FaceContact:
         )
 
     def _midpoint(self, pose: np.ndarray, t: float, time: float, state: _State):
-        """The pose after ``time`` [s] by the midpoint rule, moved back onto the face if the
-        integration carried it behind; ``None`` when a new point of the part reaches the face
+        """The pose after ``time`` [s] by the midpoint rule, put back onto the face along its
+        normal while it presses (the integration's error moves the contact off it); ``None`` when a new point of the part reaches the face
         by the half step or the end (the step of one pressing point holds only until then)."""
         half = _compose(pose, state.step.twist, time / 2)
         if self._dip(half, t + time / 2, state.keys) < -self.tolerance / 2:
@@ -290,8 +290,8 @@ class _FaceContact:
         moved = _compose(pose, midpoint.step.twist, time)
         if self._dip(moved, t + time, state.keys) < -self.tolerance / 2:
             return None
-        behind = min(self.gap(moved, t + time), 0.0)
-        moved[:2] -= behind * self.pusher.normal
+        if midpoint.step.mode != "separated":
+            moved[:2] -= self.gap(moved, t + time) * self.pusher.normal
         return moved
 
     def _dip(self, pose: np.ndarray, t: float, keys: tuple) -> float:
