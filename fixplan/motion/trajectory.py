@@ -64,8 +64,8 @@ class Trajectory:
         ``(n, 2)`` the pusher's total force on the part, world frame [N].
     contact_points : numpy.ndarray
         ``(n, 2)`` the contact point in the world frame [m] at the start of each step (or when
-        the pusher touches within it): for two points, the midpoint of the contact segment;
-        NaN where not touching.
+        the pusher touches within it): the pressing point, for two the midpoint of the contact
+        segment (a pusher touching without pressing: where it touches); NaN where not touching.
     shape : Outline
         The part's outline, in the part frame.
     pusher : PointPusher or LinePusher
