@@ -150,3 +150,14 @@ def test_a_frictionless_face_push_on_a_uniform_disk_matches_an_independent_integ
     assert (
         min(levers) < 0.4 * 0.015 and max(np.abs(levers)) < 0.04
     )  # towards the middle; on the face
+
+
+def test_a_point_pusher_trajectory_records_its_pusher_and_single_contacts():
+    pusher = PointPusher(([-0.1, 0.0], [0.05, 0.0]), mu=0.3, radius=0.005)
+    trajectory = push(SUPPORT, pusher, shape=BLOCK, duration=2.0, steps=40)
+    assert trajectory.pusher is pusher and trajectory.shape is BLOCK
+    np.testing.assert_allclose(trajectory.pusher_positions,
+                               [[-0.1 + 0.05 * t, 0.0] for t in trajectory.t], atol=1e-15)  # fmt: skip
+    touching = np.array([mode != "separated" for mode in trajectory.modes])
+    np.testing.assert_array_equal(trajectory.contact_counts, touching.astype(int))
+    assert trajectory.line_contact_travel() is None

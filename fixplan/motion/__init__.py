@@ -1,17 +1,21 @@
-"""Layer 4: how a part moves (paper §4.3) — pushing, and in time pivoting and free sliding.
+"""Layer 4: how a part moves (paper §4.3) — pushing, pivoting and sliding.
 
 Built on the limit surfaces and models of the layers below, without changing their conventions;
 imports only from :mod:`fixplan.planner`, :mod:`fixplan.models`, :mod:`fixplan.surface` and the
 top-level modules.
 """
 
-from fixplan.motion.outline import Outline
+from fixplan.motion.line_contact import line_push_step
+from fixplan.motion.outline import FacePoints, Outline
 from fixplan.motion.pivoting import Settling, settle
+from fixplan.motion.pushers import LinePusher, PointPusher
 from fixplan.motion.pushing import MotionCone, PushStep, motion_cone, push_step
 from fixplan.motion.sliding import Sliding, slide, start_acceleration
-from fixplan.motion.trajectory import PointPusher, Trajectory, push
+from fixplan.motion.trajectory import Trajectory, push
 
 __all__ = [
+    "FacePoints",
+    "LinePusher",
     "MotionCone",
     "Outline",
     "PointPusher",
@@ -19,6 +23,7 @@ __all__ = [
     "Settling",
     "Sliding",
     "Trajectory",
+    "line_push_step",
     "motion_cone",
     "push",
     "push_step",

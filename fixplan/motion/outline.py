@@ -4,10 +4,17 @@ A polygon (counter-clockwise vertices, corners included) or a disk. :meth:`Outli
 the closest point of the outline to a point, the outward unit normal there — for a point outside,
 the direction from the closest point to it, so that a round pusher of any radius touches along its
 own normal, at corners too — and the signed distance (negative inside).
+
+:meth:`Outline.face_points` serves a flat pusher face: the outline clipped to the strip the face
+sweeps, whose lowest points (along the face normal) are the ones the face touches. For a polygon
+they are the vertices of the clipped polygon: the part's vertices within the strip and the points
+where its edges cross the strip's sides (where a pusher end meets a part edge); for a disk, its
+lowest point within the strip.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -70,6 +77,84 @@ class Outline:
             normal = normals[touching].sum(axis=0)
             normal /= np.linalg.norm(normal)
         return closest[best], normal, -gap if inside else gap
+
+    def face_points(self, centre, normal, half_width: float) -> FacePoints:
+        """The points of the outline that a flat face can touch (see the module docstring).
+
+        Parameters
+        ----------
+        centre : array_like
+            Centre of the face in the part frame [m].
+        normal : array_like
+            Unit normal of the face in the part frame, pointing from the face to the part.
+        half_width : float
+            Half the face's width [m]: the strip is ``|t · (x - centre)| <= half_width`` with
+            ``t`` the normal turned a quarter counter-clockwise.
+        """
+        centre = np.asarray(centre, dtype=float)
+        normal = np.asarray(normal, dtype=float)
+        tangent = np.array([-normal[1], normal[0]])
+        if not len(self.vertices):
+            return self._disk_face_point(centre, normal, tangent, half_width)
+        along = (self.vertices - centre) @ tangent
+        inside = np.flatnonzero(np.abs(along) <= half_width)
+        keys = [("vertex", int(i)) for i in inside]
+        points, normals = [self.vertices[inside]], [np.tile(normal, (len(inside), 1))]
+        following = np.roll(np.arange(len(self.vertices)), -1)
+        edges = self.vertices[following] - self.vertices
+        inward = np.column_stack([-edges[:, 1], edges[:, 0]])
+        inward /= np.linalg.norm(inward, axis=1, keepdims=True)
+        for side in (1, -1):
+            offset = along - side * half_width
+            crossing = np.flatnonzero(offset * offset[following] < 0.0)
+            fraction = offset[crossing] / (offset[crossing] - offset[following][crossing])
+            points.append(self.vertices[crossing] + fraction[:, None] * edges[crossing])
+            normals.append(inward[crossing])
+            keys += [("edge", int(i), side) for i in crossing]
+        points = np.vstack(points)
+        return FacePoints(keys=tuple(keys), points=points, along=(points - centre) @ tangent,
+                          levels=(points - centre) @ normal, normals=np.vstack(normals))  # fmt: skip
+
+    def _disk_face_point(self, centre, normal, tangent, half_width) -> FacePoints:
+        """The disk's lowest point within the strip (none when the disk misses the strip)."""
+        along_centre, level_centre = -centre @ tangent, -centre @ normal
+        along = min(max(along_centre, -half_width), half_width)
+        off = along - along_centre
+        if abs(off) >= self.radius:
+            return FacePoints(keys=(), points=np.empty((0, 2)), along=np.empty(0),
+                              levels=np.empty(0), normals=np.empty((0, 2)))  # fmt: skip
+        level = level_centre - math.sqrt(self.radius**2 - off**2)
+        point = centre + along * tangent + level * normal
+        return FacePoints(keys=(("disk",),), points=point[None, :], along=np.array([along]),
+                          levels=np.array([level]), normals=-point[None, :] / self.radius)  # fmt: skip
+
+
+@dataclass(frozen=True, slots=True)
+class FacePoints:
+    """The candidate contact points of an outline with a flat face (see the module docstring).
+
+    Attributes
+    ----------
+    keys : tuple
+        What each point is, stable while the part moves: ``("vertex", i)``, ``("edge", i, side)``
+        (edge ``i`` from vertex ``i`` to ``i + 1`` crossing the strip side ``side = ±1`` along the
+        face) or ``("disk",)``.
+    points : numpy.ndarray
+        ``(k, 2)`` the points in the part frame [m].
+    along : numpy.ndarray
+        ``(k,)`` their position along the face from its centre (along the face tangent) [m].
+    levels : numpy.ndarray
+        ``(k,)`` their height above the face along its normal [m] (negative: behind the face).
+    normals : numpy.ndarray
+        ``(k, 2)`` the inward unit normal the part has where each point alone touches the face:
+        the face normal at a vertex, the edge's at an edge crossing, the radial one on a disk.
+    """
+
+    keys: tuple
+    points: np.ndarray
+    along: np.ndarray
+    levels: np.ndarray
+    normals: np.ndarray
 
 
 def _inside(vertices: np.ndarray, point: np.ndarray) -> bool:

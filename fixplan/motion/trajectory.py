@@ -1,12 +1,22 @@
-r"""Quasi-static pushing trajectories: a round pusher drives a part across its support.
+r"""Quasi-static pushing trajectories: a round or flat pusher drives a part across its support.
 
-At every instant the part moves with the quasi-static twist of :func:`~fixplan.motion.push_step`
-at the contact between the pusher and the part's outline (or stays at rest when they do not
-touch). The part's pose ``(x, y, θ)`` [m, m, rad] in the world is integrated on SE(2) with the
-exact exponential of the twist over each step and the explicit midpoint rule (second order in the
-step; the twist is taken again at the half step, with the contact where it is then). When the
-pusher reaches the part within a step, it first travels to the touching instant (found by
-bisection) and pushes for the rest of the step.
+At every instant the part moves with the quasi-static twist of the contact between the pusher and
+the part's outline (or stays at rest when they do not touch): :func:`~fixplan.motion.push_step`
+at a single contact point, :func:`~fixplan.motion.line_push_step` where a flat pusher's face
+touches two points of the part. The part's pose ``(x, y, θ)`` [m, m, rad] in the world is
+integrated on SE(2) with the exact exponential of the twist over each step and the explicit
+midpoint rule (second order in the step; the twist is taken again at the half step, with the
+contact where it is then). When the pusher reaches the part within a step, it first travels to
+the touching instant (found by bisection) and pushes for the rest of the step.
+
+A flat pusher touches the lowest points of the outline within the strip its face sweeps
+(:meth:`~fixplan.motion.Outline.face_points`). While the part turns about one contact point,
+another point of it reaching the face is an event: the step is cut where it comes level with
+the contact (bisection on the time within the step), and continues with both points touching —
+the part rotates onto the face without passing through it, then rides flush or rotates off as
+the mechanics say. After each integrated stretch in which the face presses, the part is put back
+onto the face along its normal: the integration moves the contact off it by the step's local
+error (third order), which would otherwise add up to a gap or an overlap.
 """
 
 from __future__ import annotations
@@ -18,59 +28,22 @@ from dataclasses import dataclass
 import numpy as np
 
 from fixplan import validation
-from fixplan.errors import InvalidArgumentError
+from fixplan.errors import InvalidArgumentError, ModelError
+from fixplan.motion.line_contact import line_push_step
 from fixplan.motion.outline import Outline
+from fixplan.motion.pushers import LinePusher, PointPusher
 from fixplan.motion.pushing import PushStep, push_step
 
 #: The pusher counts as touching the outline within this fraction of the part's size.
 TOUCH_RTOL = 1e-9
 
-#: Bisection steps that find the touching instant within a step (to 2**-50 of the step).
+#: Bisection steps that find the touching instant, or a new contact, within a step (to 2**-50
+#: of the step).
 TOUCH_BISECTIONS = 50
 
-#: Relative time step [s per s] of the central differences that give a callable path's velocity.
-PATH_STEP = 1e-6
-
-
-@dataclass(frozen=True, slots=True)
-class PointPusher:
-    """A round pusher of ``radius`` [m] (0: a point) whose centre follows ``path``.
-
-    ``path`` is ``(start, velocity)`` for a straight line [m, m/s] or a callable ``t -> (x, y)``
-    [s -> m] in the world frame; ``mu`` is the pusher–part friction coefficient (0 allowed).
-    """
-
-    path: object
-    mu: float
-    radius: float = 0.0
-
-    def __post_init__(self):
-        object.__setattr__(self, "mu", validation.nonnegative_scalar("mu", self.mu))
-        object.__setattr__(self, "radius", validation.nonnegative_scalar("radius", self.radius))
-        if not callable(self.path):
-            try:
-                start, velocity = self.path
-            except (TypeError, ValueError):
-                raise InvalidArgumentError(
-                    "path must be (start, velocity) or a callable t -> (x, y)"
-                ) from None
-            start = validation.finite_array("path start", start, shape=(2,))
-            velocity = validation.finite_array("path velocity", velocity, shape=(2,))
-            object.__setattr__(self, "path", (start, velocity))
-
-    def position(self, t: float) -> np.ndarray:
-        """Centre of the pusher at time ``t`` [s], world frame [m]."""
-        if callable(self.path):
-            return validation.finite_array("path(t)", self.path(t), shape=(2,))
-        start, velocity = self.path
-        return start + velocity * t
-
-    def velocity(self, t: float) -> np.ndarray:
-        """Velocity of the centre at time ``t`` [m/s] (central differences for a callable)."""
-        if not callable(self.path):
-            return self.path[1]
-        step = PATH_STEP * max(abs(t), 1.0)
-        return (self.position(t + step) - self.position(t - step)) / (2 * step)
+#: At most this many new contacts are made within one step; more means the contact modes cycle
+#: without the part moving (no consistent motion).
+EVENTS_PER_STEP = 8
 
 
 @dataclass(frozen=True, slots=True)
@@ -88,10 +61,22 @@ class Trajectory:
     modes : tuple of str
         Contact mode of each step (``"separated"`` where the pusher does not touch).
     forces : numpy.ndarray
-        ``(n, 2)`` the pusher's force on the part, world frame [N].
+        ``(n, 2)`` the pusher's total force on the part, world frame [N].
     contact_points : numpy.ndarray
-        ``(n, 2)`` the contact point in the world frame at the start of each step (or when the
-        pusher touches within it) [m]; NaN where not touching.
+        ``(n, 2)`` the contact point in the world frame [m] at the start of each step (or when
+        the pusher touches within it): the pressing point, for two the midpoint of the contact
+        segment (a pusher touching without pressing: where it touches); NaN where not touching.
+    shape : Outline
+        The part's outline, in the part frame.
+    pusher : PointPusher or LinePusher
+        The pusher.
+    pusher_positions : numpy.ndarray
+        ``(n + 1, 2)`` world positions of the pusher's path point (a round pusher's centre, the
+        centre of a flat pusher's face) at ``t`` [m].
+    contact_counts : numpy.ndarray
+        ``(n,)`` how many contact points press on the part at the start of each step (or when
+        the pusher touches within it): 0 (separated), 1, or 2 (a flat pusher's face flush with
+        the part).
     """
 
     t: np.ndarray
@@ -100,11 +85,25 @@ class Trajectory:
     modes: tuple[str, ...]
     forces: np.ndarray
     contact_points: np.ndarray
+    shape: Outline
+    pusher: PointPusher | LinePusher
+    pusher_positions: np.ndarray
+    contact_counts: np.ndarray
+
+    def line_contact_travel(self) -> float | None:
+        """Travel of the pusher along its path [m] (the length of the polyline through
+        :attr:`pusher_positions`) until the start of the first step with two contact points;
+        ``None`` if there is none."""
+        flush = np.flatnonzero(self.contact_counts == 2)
+        if not len(flush):
+            return None
+        moves = np.diff(self.pusher_positions[: flush[0] + 1], axis=0)
+        return float(np.linalg.norm(moves, axis=1).sum())
 
 
 def push(
     surface,
-    pusher: PointPusher,
+    pusher: PointPusher | LinePusher,
     *,
     shape: Outline,
     pose=(0.0, 0.0, 0.0),
@@ -115,84 +114,219 @@ def push(
     """Integrate the part's quasi-static motion under ``pusher`` for ``duration`` [s].
 
     ``surface`` is the support's limit surface in the part frame (see
-    :func:`~fixplan.motion.push_step`); ``shape`` the part's outline in the same frame; ``pose``
-    its initial world pose ``(x, y, θ)``; ``steps`` the number of integration steps;
+    :func:`~fixplan.motion.push_step`; for a flat pusher on a polygon also
+    :func:`~fixplan.motion.line_push_step`); ``shape`` the part's outline in the same frame;
+    ``pose`` its initial world pose ``(x, y, θ)``; ``steps`` the number of integration steps;
     ``progress(done, total)`` is called after each step.
     """
-    if not isinstance(pusher, PointPusher):
-        raise InvalidArgumentError(f"pusher must be a PointPusher, got {type(pusher).__name__}")
     if not isinstance(shape, Outline):
         raise InvalidArgumentError(f"shape must be an Outline, got {type(shape).__name__}")
+    if isinstance(pusher, PointPusher):
+        contact = _RoundContact(surface, shape, pusher)
+    elif isinstance(pusher, LinePusher):
+        contact = _FaceContact(surface, shape, pusher)
+    else:
+        raise InvalidArgumentError(
+            f"pusher must be a PointPusher or a LinePusher, got {type(pusher).__name__}"
+        )
     duration = validation.positive_scalar("duration", duration)
     if isinstance(steps, bool) or not isinstance(steps, int | np.integer) or steps < 1:
         raise InvalidArgumentError(f"steps must be a positive integer, got {steps!r}")
     pose = validation.finite_array("pose", pose, shape=(3,)).copy()
-    size = float(np.abs(shape.vertices).max()) if len(shape.vertices) else shape.radius
-    tolerance = TOUCH_RTOL * max(size, pusher.radius)
     dt = duration / steps
     times, poses = [0.0], [pose.copy()]
-    twists, modes, forces, points = [], [], [], []
+    twists, modes, forces, points, counts = [], [], [], [], []
     for k in range(steps):
         start = k * dt
-        touch = _touching_time(shape, pusher, pose, start, dt, tolerance)
+        touch = _touching_time(contact, pose, start, dt)
         if touch is None:
-            step, contact = PushStep.separated(), None
+            state = _State(PushStep.separated(), np.empty((0, 2)), np.empty((0, 2)), ())
         else:
-            rest = start + dt - touch
-            step, contact = _step(surface, shape, pusher, pose, touch)
-            if step.mode != "separated":
-                half = _compose(pose, step.twist, rest / 2)
-                midpoint, _ = _step(surface, shape, pusher, half, touch + rest / 2)
-                pose = _compose(pose, midpoint.twist, rest)
-        twists.append(step.twist)
-        modes.append(step.mode)
+            state = contact.state(pose, touch)
+            pose = contact.advance(pose, touch, start + dt, state)
+        twists.append(state.step.twist)
+        modes.append(state.step.mode)
         rotation = _rotation(poses[-1][2])
-        forces.append(rotation @ step.force)
-        points.append(np.full(2, np.nan) if contact is None else poses[-1][:2] + rotation @ contact)
+        forces.append(rotation @ state.step.force)
+        shown = state.bearing if len(state.bearing) else state.touching
+        points.append(poses[-1][:2] + rotation @ shown.mean(axis=0) if len(shown) else
+                      np.full(2, np.nan))  # fmt: skip
+        counts.append(len(state.bearing))
         times.append(start + dt)
         poses.append(pose.copy())
         if progress is not None:
             progress(k + 1, steps)
     return Trajectory(
         t=np.array(times), poses=np.array(poses), twists=np.array(twists), modes=tuple(modes),
-        forces=np.array(forces), contact_points=np.array(points),
+        forces=np.array(forces), contact_points=np.array(points), shape=shape, pusher=pusher,
+        pusher_positions=np.array([pusher.position(t) for t in times]),
+        contact_counts=np.array(counts, dtype=int),
     )  # fmt: skip
 
 
-def _local(pose: np.ndarray, point: np.ndarray) -> np.ndarray:
-    """A world point in the part frame of ``pose``."""
-    return _rotation(pose[2]).T @ (point - pose[:2])
+@dataclass(frozen=True, slots=True)
+class _State:
+    """The push at one instant: the step, the touching points and those that press (part
+    frame), and what the pressing points are on the outline (for events)."""
+
+    step: PushStep
+    touching: np.ndarray
+    bearing: np.ndarray
+    keys: tuple
 
 
-def _gap(shape: Outline, pusher: PointPusher, pose: np.ndarray, t: float) -> float:
-    """Distance between the pusher's surface and the outline at time ``t`` [m] (part at rest)."""
-    return shape.nearest(_local(pose, pusher.position(t)))[2] - pusher.radius
+class _RoundContact:
+    """A round pusher on the outline: one contact point, where the outline is nearest."""
+
+    def __init__(self, surface, shape: Outline, pusher: PointPusher):
+        self.surface, self.shape, self.pusher = surface, shape, pusher
+        size = float(np.abs(shape.vertices).max()) if len(shape.vertices) else shape.radius
+        self.tolerance = TOUCH_RTOL * max(size, pusher.radius)
+
+    def gap(self, pose: np.ndarray, t: float) -> float:
+        """Distance between the pusher's surface and the outline at time ``t`` [m]."""
+        return self.shape.nearest(_local(pose, self.pusher.position(t)))[2] - self.pusher.radius
+
+    def state(self, pose: np.ndarray, t: float) -> _State:
+        point, outward, _ = self.shape.nearest(_local(pose, self.pusher.position(t)))
+        velocity = _rotation(pose[2]).T @ self.pusher.velocity(t)
+        step = push_step(self.surface, contact=point, normal=-outward, velocity=velocity,
+                         mu=self.pusher.mu)  # fmt: skip
+        bearing = point[None, :] if step.mode != "separated" else np.empty((0, 2))
+        return _State(step, point[None, :], bearing, ())
+
+    def advance(self, pose: np.ndarray, t: float, end: float, state: _State) -> np.ndarray:
+        """The pose at ``end`` [s] by the midpoint rule from ``state`` at ``t``."""
+        if state.step.mode == "separated":
+            return pose
+        rest = end - t
+        midpoint = self.state(_compose(pose, state.step.twist, rest / 2), t + rest / 2)
+        return _compose(pose, midpoint.step.twist, rest)
 
 
-def _touching_time(shape, pusher, pose, start, dt, tolerance) -> float | None:
+class _FaceContact:
+    """A flat pusher's face on the outline: the lowest points within its strip (module
+    docstring), one or two contact points, new contacts as events."""
+
+    def __init__(self, surface, shape: Outline, pusher: LinePusher):
+        self.surface, self.shape, self.pusher = surface, shape, pusher
+        size = float(np.abs(shape.vertices).max()) if len(shape.vertices) else shape.radius
+        self.tolerance = TOUCH_RTOL * size
+
+    def points(self, pose: np.ndarray, t: float):
+        """The outline's candidate contact points with the face at time ``t``."""
+        normal = _rotation(pose[2]).T @ self.pusher.normal
+        return self.shape.face_points(_local(pose, self.pusher.position(t)), normal,
+                                      self.pusher.width / 2)  # fmt: skip
+
+    def gap(self, pose: np.ndarray, t: float) -> float:
+        """Height of the outline's lowest point in the strip above the face [m] (inf: none)."""
+        levels = self.points(pose, t).levels
+        return float(levels.min()) if len(levels) else math.inf
+
+    def state(self, pose: np.ndarray, t: float) -> _State:
+        found = self.points(pose, t)
+        if not len(found.keys):  # the part has left the strip
+            return _State(PushStep.separated(), np.empty((0, 2)), np.empty((0, 2)), ())
+        velocity = _rotation(pose[2]).T @ self.pusher.velocity(t)
+        touching = np.flatnonzero(found.levels <= found.levels.min() + self.tolerance)
+        along = found.along[touching]
+        ends = [touching[np.argmin(along)], touching[np.argmax(along)]]
+        if along.max() - along.min() > self.tolerance:
+            normal = _rotation(pose[2]).T @ self.pusher.normal
+            step, bearing = line_push_step(self.surface, contacts=found.points[ends],
+                                           normal=normal, velocity=velocity,
+                                           mu=self.pusher.mu)  # fmt: skip
+            keys = ()
+            if len(bearing) == 1:
+                end = ends[int(np.argmin(np.linalg.norm(found.points[ends] - bearing, axis=1)))]
+                keys = self._keys_at(found, touching, end)
+            return _State(step, found.points[ends], bearing, keys)
+        end = ends[0]
+        step = push_step(self.surface, contact=found.points[end], normal=found.normals[end],
+                         velocity=velocity, mu=self.pusher.mu)  # fmt: skip
+        point = found.points[end][None, :]
+        if step.mode == "separated":
+            return _State(step, point, np.empty((0, 2)), ())
+        return _State(step, point, point, self._keys_at(found, touching, end))
+
+    def _keys_at(self, found, touching: np.ndarray, end: int) -> tuple:
+        """The keys of the touching points at the place of point ``end`` (a vertex on the
+        strip's side is also an edge crossing)."""
+        near = np.abs(found.along[touching] - found.along[end]) <= self.tolerance
+        return tuple(found.keys[i] for i in touching[near])
+
+    def advance(self, pose: np.ndarray, t: float, end: float, state: _State) -> np.ndarray:
+        """The pose at ``end`` [s] by the midpoint rule from ``state`` at ``t``, cut at the
+        instants where a new point of the part reaches the face."""
+        for _ in range(EVENTS_PER_STEP):
+            if state.step.mode == "separated":
+                return pose
+            moved = self._midpoint(pose, t, end - t, state)
+            if moved is not None:
+                return moved
+            low, high = 0.0, end - t
+            for _ in range(TOUCH_BISECTIONS):
+                middle = 0.5 * (low + high)
+                if self._midpoint(pose, t, middle, state) is None:
+                    high = middle
+                else:
+                    low = middle
+            pose, t = self._midpoint(pose, t, low, state), t + low
+            state = self.state(pose, t)
+        raise ModelError(  # pragma: no cover - the mechanics lift the points they leave
+            f"more than {EVENTS_PER_STEP} new contacts within one step at t = {t} s: the contact "
+            "modes cycle without a consistent motion"
+        )
+
+    def _midpoint(self, pose: np.ndarray, t: float, time: float, state: _State):
+        """The pose after ``time`` [s] by the midpoint rule, put back onto the face along its
+        normal while it presses (the integration's error moves the contact off it); ``None`` when a new point of the part reaches the face
+        by the half step or the end (the step of one pressing point holds only until then)."""
+        half = _compose(pose, state.step.twist, time / 2)
+        if self._dip(half, t + time / 2, state.keys) < -self.tolerance / 2:
+            return None
+        midpoint = self.state(half, t + time / 2)
+        moved = _compose(pose, midpoint.step.twist, time)
+        if self._dip(moved, t + time, state.keys) < -self.tolerance / 2:
+            return None
+        if midpoint.step.mode != "separated":
+            moved[:2] -= self.gap(moved, t + time) * self.pusher.normal
+        return moved
+
+    def _dip(self, pose: np.ndarray, t: float, keys: tuple) -> float:
+        """How far the lowest other point of the part lies above the pressing point [m]
+        (negative: a new point has come closer to the face); inf when the pressing point has
+        left the strip or ``keys`` is empty (two pressing points: the part translates)."""
+        if not keys:
+            return math.inf
+        found = self.points(pose, t)
+        pressing = [k for k, key in enumerate(found.keys) if key in keys]
+        others = [k for k, key in enumerate(found.keys) if key not in keys]
+        if not pressing or not others:
+            return math.inf
+        return float(found.levels[others].min() - found.levels[pressing].min())
+
+
+def _touching_time(contact, pose, start, dt) -> float | None:
     """When within ``[start, start + dt]`` the pusher touches the resting part (``None``: not)."""
-    if _gap(shape, pusher, pose, start) <= tolerance:
+    if contact.gap(pose, start) <= contact.tolerance:
         return start
-    if _gap(shape, pusher, pose, start + dt) > tolerance:
+    if contact.gap(pose, start + dt) > contact.tolerance:
         return None
     low, high = start, start + dt
     for _ in range(TOUCH_BISECTIONS):
         middle = 0.5 * (low + high)
-        if _gap(shape, pusher, pose, middle) > tolerance:
+        if contact.gap(pose, middle) > contact.tolerance:
             low = middle
         else:
             high = middle
     return high
 
 
-def _step(surface, shape, pusher, pose, t) -> tuple[PushStep, np.ndarray]:
-    """The push step at time ``t`` with the part at ``pose`` and the pusher touching it (to
-    within the step's accuracy), and the contact point in the part frame."""
-    centre = _local(pose, pusher.position(t))
-    point, outward, _ = shape.nearest(centre)
-    velocity = _rotation(pose[2]).T @ pusher.velocity(t)
-    step = push_step(surface, contact=point, normal=-outward, velocity=velocity, mu=pusher.mu)
-    return step, point
+def _local(pose: np.ndarray, point: np.ndarray) -> np.ndarray:
+    """A world point in the part frame of ``pose``."""
+    return _rotation(pose[2]).T @ (point - pose[:2])
 
 
 def _rotation(angle: float) -> np.ndarray:
