@@ -129,3 +129,13 @@ MIN_PATCH_LENGTH = 1e-9
 
 #: Largest ratio of a rectangle patch's sides (the inverse map loses accuracy on needles).
 MAX_ASPECT_RATIO = 1e5
+
+#: Largest speed of a pusher [m/s].
+MAX_SPEED = 1e3
+
+#: Longest simulated time [s] (about eleven days).
+MAX_DURATION = 1e6
+
+#: Most integration steps of one simulation (each is a few quasi-static steps: about a minute
+#: with the exact limit surface).
+MAX_STEPS = 100_000

@@ -164,6 +164,16 @@ def _build_parser() -> argparse.ArgumentParser:
     compare.add_argument("--solver", choices=("CLARABEL", "OSQP", "SCS"), help="solver")
     _verbosity(compare)
     compare.set_defaults(run=_run_compare)
+
+    push = _subcommand(
+        commands, "push", "simulate a part pushed across its support (a push file)",
+        "fixplan push problems/push-box-point.toml --report out/",
+    )  # fmt: skip
+    push.add_argument("file", type=Path, help='push file (TOML, kind = "push")')
+    push.add_argument("--json", action="store_true", help="print one JSON document")
+    push.add_argument("--report", type=Path, metavar="DIR", help="write a report folder")
+    _verbosity(push)
+    push.set_defaults(run=_run_push)
     return parser
 
 
@@ -338,13 +348,45 @@ def _run_plan(args: argparse.Namespace) -> tuple[int, str]:
     return _exit_code(plan), _summary(problem_file, plan)
 
 
+# -- push ----------------------------------------------------------------------------------------
+
+
+def _run_push(args: argparse.Namespace) -> tuple[int, str]:
+    from fixplan.io.push_file import load_push
+    from fixplan.io.push_report import describe_push, push_summary, write_push_report
+    from fixplan.motion import push
+
+    push_file = load_push(args.file)
+    if args.report is not None:
+        _check_output_folder(args.report, "--report")
+    log.info("pushing %s (%d steps)", args.file, push_file.steps)
+    trajectory = push(
+        push_file.surface, push_file.pusher, shape=push_file.shape, pose=push_file.pose,
+        duration=push_file.duration, steps=push_file.steps,
+        progress=_Progress("pushing", not args.quiet),
+    )  # fmt: skip
+    if args.report is not None:
+        written = write_push_report(args.report, push_file, trajectory)
+        log.info("wrote %d report files to %s", len(written), args.report)
+    summary = push_summary(push_file, trajectory)
+    if args.json:
+        summary["problem"] = {"file": str(push_file.path), "sha256": push_file.sha256}
+        return EXIT_OK, _json(summary)
+    return EXIT_OK, "\n".join(describe_push(summary))
+
+
 # -- check ---------------------------------------------------------------------------------------
 
 
 def _run_check(args: argparse.Namespace) -> tuple[int, str]:
     from fixplan.io.problem_file import ProblemFileError, check_problem
+    from fixplan.io.push_file import KIND as PUSH_KIND
+    from fixplan.io.push_file import file_kind, load_push
 
     try:
+        if file_kind(args.file) == PUSH_KIND:
+            push_file = load_push(args.file)
+            return EXIT_OK, _checked_push(args, push_file)
         problem_file = check_problem(args.file)
     except ProblemFileError as exc:
         if not args.json:
@@ -370,6 +412,18 @@ def _run_check(args: argparse.Namespace) -> tuple[int, str]:
     return EXIT_OK, (
         f"{args.file}: valid — {problem_file.name} ({problem_file.kind}), objective "
         f"{problem.objective}, {len(problem.contacts)} contacts, {len(problem.loads)} load cases"
+    )
+
+
+def _checked_push(args: argparse.Namespace, push_file) -> str:
+    """What ``check`` says of a valid push file."""
+    if args.json:
+        document = {"file": str(args.file), "valid": True, "issues": [], "name": push_file.name,
+                    "kind": "push", "sha256": push_file.sha256}  # fmt: skip
+        return _json(document)
+    return (
+        f"{args.file}: valid — {push_file.name} (push), {type(push_file.pusher).__name__}, "
+        f"{push_file.model} support, {push_file.steps} steps over {push_file.duration:g} s"
     )
 
 

@@ -1,4 +1,5 @@
-r"""Figures of a plan: contact layout, friction use per contact, safety factors, fixture surface.
+r"""Figures of a plan (contact layout, friction use per contact, safety factors, fixture surface)
+and of a pushed part's trajectory (a figure and an animated GIF).
 
 Every function computes its data first (plain numpy) and draws it second, on a
 :class:`matplotlib.figure.Figure` with the Agg canvas (never ``pyplot``, so no global state and
@@ -650,3 +651,148 @@ def _draw_section(ax, curve, color, label, load, limit) -> None:
         ax.plot(*limit, marker="x", color="tab:red", markersize=8, linestyle="none",
                 label=r"load $\times$ safety factor")  # fmt: skip
     ax.plot(*load, marker="o", color="black", linestyle="none", label="load")
+
+
+# -- pushing trajectories -----------------------------------------------------------------------
+
+#: Colour of each contact mode in :func:`trajectory_figure` and :func:`save_gif`.
+MODE_COLORS = {
+    "sticking": "tab:green",
+    "sliding-left": "tab:orange",
+    "sliding-right": "tab:purple",
+    "separated": "tab:gray",
+}
+#: Largest number of frames of :func:`save_gif` (longer trajectories are sampled evenly).
+GIF_MAX_FRAMES = 40
+
+
+@dataclass(frozen=True, slots=True)
+class _Scene:
+    """What a trajectory figure draws, in the world frame [mm]."""
+
+    outlines: tuple[np.ndarray, ...]  # (k, 2) closed outline per drawn pose
+    origins: np.ndarray  # (n + 1, 2) path of the part frame's origin
+    pusher_path: np.ndarray  # (n + 1, 2)
+    pushers: tuple[np.ndarray, ...]  # (k, 2) outline of the pusher per drawn pose
+    contacts: np.ndarray  # (n, 2) contact points (NaN: none)
+    modes: tuple[str, ...]
+    indices: np.ndarray  # the drawn samples
+
+
+def _world_outline(shape, pose: np.ndarray) -> np.ndarray:
+    """Closed outline ``(k, 2)`` of ``shape`` at ``pose`` [m]; a disk gets a radius line so that
+    its turning shows."""
+    if len(shape.vertices):
+        local = np.vstack([shape.vertices, shape.vertices[:1]])
+    else:
+        angles = np.linspace(0.0, 2.0 * np.pi, 73)
+        circle = shape.radius * np.column_stack([np.cos(angles), np.sin(angles)])
+        local = np.vstack([[0.0, 0.0], circle])
+    c, s = np.cos(pose[2]), np.sin(pose[2])
+    return local @ np.array([[c, s], [-s, c]]) + pose[:2]
+
+
+def _pusher_outline(pusher, position: np.ndarray) -> np.ndarray:
+    """The pusher's drawn shape at ``position`` [m]: a circle (a point for radius 0) or its face."""
+    if hasattr(pusher, "width"):
+        face = np.array([-pusher.normal[1], pusher.normal[0]]) * pusher.width / 2
+        return np.vstack([position - face, position + face])
+    angles = np.linspace(0.0, 2.0 * np.pi, 37)
+    return position + pusher.radius * np.column_stack([np.cos(angles), np.sin(angles)])
+
+
+def _scene(trajectory, frames: int) -> _Scene:
+    poses = np.asarray(trajectory.poses)
+    indices = np.unique(np.linspace(0, len(poses) - 1, max(2, frames)).round().astype(int))
+    mm = 1e3
+    positions = np.asarray(trajectory.pusher_positions)
+    return _Scene(
+        outlines=tuple(mm * _world_outline(trajectory.shape, poses[k]) for k in indices),
+        origins=mm * poses[:, :2],
+        pusher_path=mm * positions,
+        pushers=tuple(mm * _pusher_outline(trajectory.pusher, positions[k]) for k in indices),
+        contacts=mm * np.asarray(trajectory.contact_points),
+        modes=tuple(trajectory.modes),
+        indices=indices,
+    )
+
+
+def _scene_axes(ax, scene: _Scene) -> None:
+    points = np.vstack([*scene.outlines, *scene.pushers, scene.pusher_path])
+    low, high = points.min(axis=0), points.max(axis=0)
+    margin = 0.05 * float(max(high - low)) + 1e-9
+    ax.set_xlim(low[0] - margin, high[0] + margin)
+    ax.set_ylim(low[1] - margin, high[1] + margin)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel("y [mm]")
+
+
+def trajectory_figure(trajectory, *, frames: int = 8, ax: Axes | None = None) -> Figure:
+    """A pushed part's trajectory (:func:`fixplan.motion.push`) in the world plane [mm].
+
+    The part's outline at ``frames`` evenly spaced instants (fading from the start to the end,
+    the last bold), the path of the part frame's origin, the pusher's path (dashed) and the
+    pusher at the same instants, and the contact points coloured by contact mode
+    (:data:`MODE_COLORS`).
+
+    Returns
+    -------
+    Figure
+    """
+    if frames < 2:
+        raise InvalidArgumentError(f"frames must be at least 2, got {frames}")
+    scene = _scene(trajectory, frames)
+    if ax is None:
+        ax = _new_figure((7.0, 5.0)).add_subplot()
+    count = len(scene.outlines)
+    for k, (outline, pusher) in enumerate(zip(scene.outlines, scene.pushers, strict=True)):
+        shade = 0.25 + 0.75 * k / (count - 1)
+        last = k == count - 1
+        ax.plot(*outline.T, color="tab:blue", alpha=shade, linewidth=2.0 if last else 1.0,
+                label="part" if last else None)  # fmt: skip
+        ax.plot(*pusher.T, color="black", alpha=shade, linewidth=2.0 if last else 1.0,
+                label="pusher" if last else None)  # fmt: skip
+    ax.plot(*scene.origins.T, color="tab:blue", linestyle=":", linewidth=1.0,
+            label="part frame origin")  # fmt: skip
+    ax.plot(*scene.pusher_path.T, color="black", linestyle="--", linewidth=0.8,
+            label="pusher path")  # fmt: skip
+    modes = np.array(scene.modes)
+    for mode, color in MODE_COLORS.items():
+        chosen = (modes == mode) & np.all(np.isfinite(scene.contacts), axis=1)
+        if chosen.any():
+            ax.scatter(*scene.contacts[chosen].T, s=6, color=color, label=mode, zorder=3)
+    _scene_axes(ax, scene)
+    ax.legend(loc="best", fontsize=8)
+    ax.set_title(f"pushed part over {trajectory.t[-1]:.3g} s", fontsize=11)
+    return ax.figure
+
+
+def save_gif(trajectory, path: str | os.PathLike[str], *, fps: int = 10) -> None:
+    """Write an animated GIF of a pushed part (matplotlib's Pillow writer): the part and the
+    pusher at up to :data:`GIF_MAX_FRAMES` evenly spaced instants, the part's outline coloured
+    by the contact mode of the step it is in."""
+    from matplotlib.animation import PillowWriter
+
+    scene = _scene(trajectory, GIF_MAX_FRAMES)
+    fig = _new_figure((6.0, 4.5))
+    ax = fig.add_subplot()
+    _scene_axes(ax, scene)
+    ax.plot(*scene.pusher_path.T, color="black", linestyle="--", linewidth=0.8)
+    (part,) = ax.plot([], [], linewidth=2.0)
+    (pusher,) = ax.plot([], [], color="black", linewidth=2.0)
+    (trace,) = ax.plot([], [], color="tab:blue", linestyle=":", linewidth=1.0)
+    title = ax.set_title("t = 0 s, separated", fontsize=10)
+    fig.canvas.draw()
+    fig.set_layout_engine("none")  # laid out once: every frame has the same axes
+
+    writer = PillowWriter(fps=fps)
+    with writer.saving(fig, os.fspath(path), dpi=DPI):
+        for frame, k in enumerate(scene.indices):
+            mode = scene.modes[min(k, len(scene.modes) - 1)] if scene.modes else "separated"
+            part.set_data(*scene.outlines[frame].T)
+            part.set_color(MODE_COLORS[mode])
+            pusher.set_data(*scene.pushers[frame].T)
+            trace.set_data(*scene.origins[: k + 1].T)
+            title.set_text(f"t = {trajectory.t[k]:.3g} s, {mode}")
+            writer.grab_frame()

@@ -302,6 +302,9 @@ class _Reader:
         top.check_keys(_TOP_KEYS)
         check_schema_version(top)
         name = top.get("name", _NAME, required=True)
+        if data.get("kind") == "push":
+            top.report("kind", "a push file (kind = 'push'): run it with `fixplan push FILE`")
+            return None, None, None
         kind = top.get("kind", Choice(KINDS), required=True)
         objective = top.get("objective", Choice(OBJECTIVES), required=True)
         if "description" in data and not isinstance(data["description"], str):
