@@ -398,3 +398,18 @@ def test_example_runs_and_writes_its_plot(script, png, words, tmp_path):
     assert result.returncode == 0, result.stderr
     assert words in result.stdout
     assert (tmp_path / png).stat().st_size > 10_000
+
+
+@pytest.mark.slow
+def test_the_pushing_example_runs_and_writes_its_figures(tmp_path):
+    result = subprocess.run(
+        [sys.executable, str(EXAMPLES / "pushing.py"), "--figures", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=tmp_path,
+    )
+    assert result.returncode == 0, result.stderr
+    assert "flush against the face after 59.8 mm of pusher travel" in result.stdout
+    for name in ("push-finger.png", "push-finger.gif", "push-flat.png", "push-flat.gif"):
+        assert (tmp_path / name).stat().st_size > 10_000

@@ -1,6 +1,7 @@
 """The README tells the truth: its commands are what CI runs, its problem-file sample is a
 complete valid problem, and its example error is what ``fixplan check`` prints."""
 
+import math
 import re
 from pathlib import Path
 
@@ -60,3 +61,17 @@ def test_the_quick_start_output_is_what_plan_prints(capsys, monkeypatch):
     monkeypatch.chdir(ROOT)
     assert main(["plan", "problems/vise-milling.toml"]) == EXIT_OK
     assert capsys.readouterr().out == documented
+
+
+def test_the_pushing_example_gives_the_numbers_its_comments_state():
+    (code,) = _blocks(_section("Pushing, pivoting and sliding (`fixplan.motion`)"), "python")
+    names: dict = {}
+    exec(code, names)
+    x, y, theta = names["pushed"].poses[-1]
+    assert (round(1e3 * x, 1), round(1e3 * y, 1), round(math.degrees(theta), 1)) == (
+        54.8,
+        -22.8,
+        -33.8,
+    )
+    assert names["step"].mode == "sliding-right"
+    assert round(names["squared"].line_contact_travel(), 4) == 0.0598
