@@ -14,6 +14,12 @@ his pusher friction. Printed per group: the measured mean motion, the mean final
 to Zhou's simulated poses (the same model: it should vanish), and the mean error against the
 measurements of fixplan and of Zhou's simulator.
 
+With ``--no-fit`` the same pushes are also simulated with no fitted model at all: the exact limit
+surface of uniform pressure over the object's outline (the steel objects are flat-bottomed), with
+Zhou's pusher friction. The support's friction coefficient scales the limit surface and so the
+forces, not the motion (only the direction of the twist matters), so none is needed for the
+poses; it is taken as 1.
+
 Run: ``python examples/pushing_real_data.py [--data DIR] [--group abs/rect1 ...] [--steps N]``.
 """
 
@@ -27,6 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fixplan import LimitSurface, pressure
 from fixplan.models import FittedEllipsoid
 from fixplan.motion import Outline, PointPusher, push
 
@@ -43,8 +50,11 @@ def angle_difference(a: float, b: float) -> float:
     return abs((a - b + math.pi) % (2 * math.pi) - math.pi)
 
 
-def simulate_group(data: Path, group: str, steps: int) -> dict:
-    """Mean errors [mm, deg] of fixplan's simulation of one group's test pushes."""
+def simulate_group(
+    data: Path, group: str, steps: int, no_fit: bool = False, limit: int | None = None
+) -> dict:
+    """Mean errors [mm, deg] of fixplan's simulation of one group's test pushes (and of the
+    exact limit surface of uniform pressure when ``no_fit``)."""
     surface_name, shape_name = group.split("/")
     shapes = json.loads((data / "mcube_shapes.json").read_text())["shapes"]
     fit = json.loads((data / "mcube_zhou_fits.json").read_text())["fits"][group]["quadratic"]
@@ -52,12 +62,14 @@ def simulate_group(data: Path, group: str, steps: int) -> dict:
     # Zhou's H(x) = xᵀ A x with x = (fx, fy, m / rho): q of a model with mu = 1 and that rho.
     model = FittedEllipsoid(matrix=np.array(fit["A_normalised"]), mu=1.0, rho=shape["rho_m"])
     outline = Outline.polygon(shape["vertices_m"])
+    uniform = LimitSurface(pressure.polygon(shape["vertices_m"], centered=False), mu=1.0)
     with (data / "mcube_test_pushes.csv").open(newline="") as handle:
         rows = [r for r in csv.DictReader(handle) if (r["surface"], r["shape"]) == (surface_name,
                                                                                    shape_name)]  # fmt: skip
     errors = {"zhou_mm": [], "zhou_deg": [], "ours_mm": [], "ours_deg": [], "sim_mm": [],
-              "sim_deg": [], "moved_mm": [], "turned_deg": []}  # fmt: skip
-    for row in rows:
+              "sim_deg": [], "moved_mm": [], "turned_deg": [], "exact_mm": [],
+              "exact_deg": []}  # fmt: skip
+    for row in rows[:limit]:
         x = {k: float(v) for k, v in row.items() if k not in ("surface", "shape")}
         start = np.array([x["tipx0_m"], x["tipy0_m"]])
         velocity = np.array([x["tipx1_m"], x["tipy1_m"]]) - start  # over 1 s
@@ -66,16 +78,16 @@ def simulate_group(data: Path, group: str, steps: int) -> dict:
         final = push(model, pusher, shape=outline, pose=pose, duration=1.0, steps=steps).poses[-1]
         measured = np.array([x["x1_m"], x["y1_m"], x["th1_rad"]])
         zhou = np.array([x["quad_x1_m"], x["quad_y1_m"], x["quad_th1_rad"]])
-        for key, a, b in (
-            ("zhou", final, zhou),
-            ("ours", final, measured),
-            ("sim", zhou, measured),
-        ):
+        pairs = [("zhou", final, zhou), ("ours", final, measured), ("sim", zhou, measured)]
+        if no_fit:
+            exact = push(uniform, pusher, shape=outline, pose=pose, duration=1.0, steps=steps)
+            pairs.append(("exact", exact.poses[-1], measured))
+        for key, a, b in pairs:
             errors[f"{key}_mm"].append(1000 * np.linalg.norm(a[:2] - b[:2]))
             errors[f"{key}_deg"].append(math.degrees(angle_difference(a[2], b[2])))
         errors["moved_mm"].append(1000 * math.hypot(x["x1_m"] - x["x0_m"], x["y1_m"] - x["y0_m"]))
         errors["turned_deg"].append(math.degrees(angle_difference(x["th1_rad"], x["th0_rad"])))
-    return {"pushes": len(rows), **{k: float(np.mean(v)) for k, v in errors.items()}}
+    return {"pushes": len(rows[:limit]), **{k: float(np.mean(v)) for k, v in errors.items() if v}}
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -88,18 +100,24 @@ def main(argv: list[str] | None = None) -> None:
         help=f"exit 1 when fixplan is farther than {AGREEMENT_MM} mm or {AGREEMENT_DEG}° from "
         "Zhou's simulated final poses on average (a regression)",
     )  # fmt: skip
+    parser.add_argument(
+        "--no-fit", action="store_true",
+        help="also simulate with the exact limit surface of uniform pressure over the outline",
+    )  # fmt: skip
+    parser.add_argument("--limit", type=int, help="only the first N test pushes of each group")
     args = parser.parse_args(argv)
     failed = []
     print("pushing with Zhou's ellipsoid and pusher friction (MIT push dataset, ABS sheet);")
     print("errors are mean final-pose differences over the group's test pushes")
     print(f"{'group':12s} {'pushes':>6s} {'moved':>14s} {'fixplan-Zhou':>16s} {'fixplan-meas.':>16s}"
-          f" {'Zhou-meas.':>16s}")  # fmt: skip
+          f" {'Zhou-meas.':>16s}" + (f" {'no fit-meas.':>16s}" if args.no_fit else ""))  # fmt: skip
     for group in args.group:
-        r = simulate_group(args.data, group, args.steps)
+        r = simulate_group(args.data, group, args.steps, args.no_fit, args.limit)
+        no_fit = f" {r['exact_mm']:7.2f} mm {r['exact_deg']:5.2f}°" if args.no_fit else ""
         print(
             f"{group:12s} {r['pushes']:6d} {r['moved_mm']:6.1f} mm {r['turned_deg']:4.1f}° "
             f"{r['zhou_mm']:7.3f} mm {r['zhou_deg']:5.3f}° {r['ours_mm']:7.2f} mm {r['ours_deg']:5.2f}° "
-            f"{r['sim_mm']:7.2f} mm {r['sim_deg']:5.2f}°"
+            f"{r['sim_mm']:7.2f} mm {r['sim_deg']:5.2f}°{no_fit}"
         )
         if r["zhou_mm"] > AGREEMENT_MM or r["zhou_deg"] > AGREEMENT_DEG:
             failed.append(group)
