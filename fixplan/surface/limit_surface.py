@@ -327,7 +327,7 @@ def _vectors(name: str, value: object) -> tuple[np.ndarray, bool, int | None]:
     (``None`` if there is none); one finite 3-vector takes a fast path (single queries)."""
     if isinstance(value, np.ndarray) and value.shape == (3,) and value.dtype == np.float64:
         entries = value.tolist()
-        if all(isinstance(x, float) and math.isfinite(x) for x in entries):
+        if all(map(math.isfinite, entries)):
             return value[np.newaxis, :], True, None if any(entries) else 0
     array, single = validation.vector_batch(name, value, width=3)
     zero = np.flatnonzero(~np.any(array != 0.0, axis=1))

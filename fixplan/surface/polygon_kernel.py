@@ -42,24 +42,12 @@ from fixplan.tolerances import FAR_FIELD_RADII
 
 
 def _edge_sums(  # pragma: no cover - compiled
-    ax_,
-    ay_,
-    bx_,
-    by_,
-    ex,
-    ey,
-    weights,
-    reach,
-    twists,
-    with_hessian,
-    out_h,
-    out_g,
-    out_hess,
-    out_far,
+    edges, reach, twists, with_hessian, out_h, out_g, out_hess, out_far
 ):
     """Support values ``out_h``, loads ``out_g`` and, ``with_hessian``, Hessians ``out_hess`` of
     the twists whose centre of rotation lies within ``reach`` [m]; ``out_far`` marks the others
-    (their rows are left unset), whose number is returned."""
+    (their rows are left unset), whose number is returned. ``edges`` ``(7, E)`` holds the
+    starts' x and y, the ends' x and y, the unit directions' x and y and the weights."""
     far_count = 0
     for k in numba.prange(twists.shape[0]):
         vx, vy, w = twists[k, 0], twists[k, 1], twists[k, 2]
@@ -76,17 +64,17 @@ def _edge_sums(  # pragma: no cover - compiled
         m00 = 0.0  # ∇²M
         m01 = 0.0
         m11 = 0.0
-        for i in range(ax_.shape[0]):
-            q = weights[i]
-            dx = ex[i]
-            dy = ey[i]
+        for i in range(edges.shape[1]):
+            q = edges[6, i]
+            dx = edges[4, i]
+            dy = edges[5, i]
             nx = dy
             ny = -dx
-            ax = ax_[i] - cx
-            ay = ay_[i] - cy
+            ax = edges[0, i] - cx
+            ay = edges[1, i] - cy
             d = nx * ax + ny * ay
             ta = dx * ax + dy * ay
-            tb = dx * (bx_[i] - cx) + dy * (by_[i] - cy)
+            tb = dx * (edges[2, i] - cx) + dy * (edges[3, i] - cy)
             ra = math.sqrt(d * d + ta * ta)
             rb = math.sqrt(d * d + tb * tb)
             absd = abs(d)
@@ -145,7 +133,7 @@ class EdgeSumKernel(SupportKernel):
     ends: np.ndarray
     weights: np.ndarray
     far: PointSetKernel
-    _columns: tuple[np.ndarray, ...] = field(init=False, repr=False)
+    _edges: np.ndarray = field(init=False, repr=False)
     _size: float = field(init=False, repr=False)
 
     def __post_init__(self):
@@ -153,12 +141,9 @@ class EdgeSumKernel(SupportKernel):
         ends = np.asarray(self.ends, dtype=float)
         direction = ends - starts
         length = np.hypot(direction[:, 0], direction[:, 1])
-        columns = (
-            starts[:, 0], starts[:, 1], ends[:, 0], ends[:, 1],
-            direction[:, 0] / length, direction[:, 1] / length,
-            np.asarray(self.weights, dtype=float),
-        )  # fmt: skip
-        object.__setattr__(self, "_columns", tuple(np.ascontiguousarray(c) for c in columns))
+        columns = (starts, ends, direction / length[:, None], np.asarray(self.weights, dtype=float))
+        edges = np.ascontiguousarray(np.column_stack(columns).T)
+        object.__setattr__(self, "_edges", edges)
         object.__setattr__(self, "_size", self.far.size)
 
     @property
@@ -173,7 +158,7 @@ class EdgeSumKernel(SupportKernel):
         hess = np.empty((count if with_hessian else 0, 3, 3))
         far = np.empty(count, dtype=np.bool_)
         far_count = _pick(_EDGE_SUMS, count, len(self.weights))(
-            *self._columns, FAR_FIELD_RADII * self._size, twists, with_hessian, h, g, hess, far
+            self._edges, FAR_FIELD_RADII * self._size, twists, with_hessian, h, g, hess, far
         )
         return twists, far if far_count else None, h, g, hess
 
