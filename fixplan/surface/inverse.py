@@ -16,6 +16,7 @@ balance it is within its friction limit.
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -171,41 +172,63 @@ def _solve_one(kernel: SupportKernel, load: np.ndarray, units: np.ndarray):
     The same damped Newton method as :func:`_newton`, run on SI twists ``V = Z / units``
     projected onto the plane by ``b = e / units``: ``g·b`` and ``bᵀ H b`` are then the
     normalised gradient and Hessian of :func:`solve`, so the iterates are the same to rounding.
-    The friction scale only multiplies ``h`` and drops out of every test.
+    The friction scale only multiplies ``h`` and drops out of every test. Vectors are lists of
+    floats: numpy costs more than the arithmetic at this size.
     """
-    normalised = (load / units).tolist()
+    u = units.tolist()
+    normalised = [x / ux for x, ux in zip(load.tolist(), u, strict=True)]
     length = math.sqrt(sum(x * x for x in normalised))
     direction = [x / length for x in normalised]
-    basis = np.array(_plane_basis_one(direction)) / units
-    twist = np.array(direction) / (length * units)
-    h, g, hess = kernel.newton_terms(twist[None, :])
-    h = float(h[0])
+    b1, b2 = ([x / ux for x, ux in zip(e, u, strict=True)] for e in _plane_basis_one(direction))
+    twist = [x / (length * ux) for x, ux in zip(direction, u, strict=True)]
+    h, g, hess = _terms_one(kernel, twist)
     stalled = True
     for _ in range(INVERSE_MAX_ITERATIONS):
-        step, decrement = _newton_step_one(basis @ g[0], basis @ hess[0] @ basis.T)
+        (s1, s2), decrement = _newton_step_one(*_projected(g, hess, b1, b2))
         if decrement <= INVERSE_RTOL**2 * h:
             stalled = False
             break
-        step = step @ basis
-        t = 1.0
+        step = [s1 * x + s2 * y for x, y in zip(b1, b2, strict=True)]
+        # The full step is tried with the terms of the next iteration: it is nearly always taken.
+        trial = [x + dx for x, dx in zip(twist, step, strict=True)]
+        terms = _terms_one(kernel, trial)
         # Near the minimum the sufficient decrease is below rounding: full steps are taken.
-        if decrement > QUADRATIC_REGION * h:
-            for _ in range(_MAX_HALVINGS):
-                if float(kernel.support((twist + t * step)[None, :])[0]) <= (
-                    h - 1e-4 * t * decrement
-                ):
+        if decrement > QUADRATIC_REGION * h and terms[0] > h - 1e-4 * decrement:
+            t = 0.5
+            for _ in range(_MAX_HALVINGS - 1):
+                trial = [x + t * dx for x, dx in zip(twist, step, strict=True)]
+                if float(kernel.support(np.array([trial]))[0]) <= h - 1e-4 * t * decrement:
                     break
                 t *= 0.5
             else:
                 break
-        twist = twist + t * step
-        h, g, hess = kernel.newton_terms(twist[None, :])
-        h = float(h[0])
+            terms = _terms_one(kernel, trial)
+        twist = trial
+        h, g, hess = terms
     if stalled:
-        projected = math.hypot(*(basis @ g[0]).tolist())
-        if projected > INVERSE_GRADIENT_RTOL * h:
-            raise _not_converged(load, projected / h)
-    return h, twist
+        g1, g2 = _projected(g, hess, b1, b2)[:2]
+        if math.hypot(g1, g2) > INVERSE_GRADIENT_RTOL * h:
+            raise _not_converged(load, math.hypot(g1, g2) / h)
+    return h, np.array(twist)
+
+
+def _terms_one(kernel: SupportKernel, twist: list[float]):
+    """``h``, gradient (3 floats) and Hessian (3 rows of 3) of the kernel at one twist."""
+    h, g, hess = kernel.newton_terms(np.array([twist]))
+    return float(h[0]), g[0].tolist(), hess[0].tolist()
+
+
+def _projected(g, hess, b1, b2) -> tuple[float, float, float, float, float]:
+    """``g·b1``, ``g·b2``, ``b1ᵀ H b1``, ``b1ᵀ H b2`` and ``b2ᵀ H b2``."""
+    hb1 = [sum(map(operator.mul, row, b1)) for row in hess]
+    hb2 = [sum(map(operator.mul, row, b2)) for row in hess]
+    return (
+        sum(map(operator.mul, g, b1)),
+        sum(map(operator.mul, g, b2)),
+        sum(map(operator.mul, b1, hb1)),
+        sum(map(operator.mul, b1, hb2)),
+        sum(map(operator.mul, b2, hb2)),
+    )
 
 
 def _plane_basis_one(direction: list[float]) -> tuple[list[float], list[float]]:
@@ -219,11 +242,9 @@ def _plane_basis_one(direction: list[float]) -> tuple[list[float], list[float]]:
     return [ax, ay, az], [dy * az - dz * ay, dz * ax - dx * az, dx * ay - dy * ax]
 
 
-def _newton_step_one(gradient: np.ndarray, hessian: np.ndarray) -> tuple[np.ndarray, float]:
-    """:func:`_newton_step` of one point, given the projected gradient ``(2,)`` and Hessian
-    ``(2, 2)``: the step in plane coordinates and the decrement."""
-    g1, g2 = gradient.tolist()
-    (h11, h12), (_, h22) = hessian.tolist()
+def _newton_step_one(g1, g2, h11, h12, h22) -> tuple[tuple[float, float], float]:
+    """:func:`_newton_step` of one point from its projected gradient and Hessian: the step in
+    plane coordinates and the decrement."""
     ridge = 1e-14 * abs(h11 + h22) + 1e-300
     h11, h22 = h11 + ridge, h22 + ridge
     det = h11 * h22 - h12 * h12
@@ -232,9 +253,9 @@ def _newton_step_one(gradient: np.ndarray, hessian: np.ndarray) -> tuple[np.ndar
         s2 = -(h11 * g2 - h12 * g1) / det
         decrement = -(g1 * s1 + g2 * s2)
         if math.isfinite(decrement) and decrement >= 0.0:
-            return np.array([s1, s2]), decrement
+            return (s1, s2), decrement
     # Steepest descent where the Hessian is unusable (never at a smooth minimum).
-    return np.array([-g1, -g2]), g1 * g1 + g2 * g2
+    return (-g1, -g2), g1 * g1 + g2 * g2
 
 
 def _check_converged(z, e1, e2, loads, terms) -> None:
