@@ -262,7 +262,7 @@ class _Geometry:
             twist = tuple(_dot(row, load) for row in self.ellipsoid)
         else:
             twist = tuple(np.asarray(self.surface.motion(np.array(load)), dtype=float).tolist())
-        if not all(math.isfinite(x) for x in twist):
+        if not all(map(math.isfinite, twist)):
             raise ModelError(f"the surface gives no motion for the load {np.array(load)}")
         return _scaled(twist, 1.0 / math.sqrt(_dot(twist, twist)))
 
@@ -294,28 +294,33 @@ class _Geometry:
         if forward is None:
             return None
         cx, cy = self.contact
-        start = np.array([velocity[0], velocity[1], 0.0])
-        turn = np.array([cy, -cx, 1.0])
+        vx, vy = velocity
+        turn = (cy, -cx, 1.0)  # N: rotation about the contact point
+
+        def on_line(s: float) -> np.ndarray:  # V_0 + s N
+            return np.array([vx + s * cy, vy - s * cx, s])
 
         def slope(s: float) -> float:
-            return float(np.asarray(forward(start + s * turn)) @ turn)
+            return _dot(np.asarray(forward(on_line(s))).tolist(), turn)
 
-        reach = math.hypot(*velocity) / max(math.hypot(cx, cy), _MIN_LEVER)
+        reach = math.hypot(vx, vy) / max(math.hypot(cx, cy), _MIN_LEVER)
         low, high = -reach, reach
         while slope(low) > 0.0:
             low *= 2.0
         while slope(high) < 0.0:
             high *= 2.0
         s = brentq(slope, low, high, xtol=ANGLE_XTOL * reach, rtol=4 * _EPS)
-        twist = start + s * turn
         # At a kink of h (a support point at rest) the slope jumps across 0: the load is the
         # combination of the one-sided loads whose slope is 0 (a subgradient).
         step = max(abs(s), reach) * _KINK_STEP
-        below, above = (np.asarray(forward(start + x * turn)) for x in (s - step, s + step))
-        a, b = float(below @ turn), float(above @ turn)
-        load = below + (above - below) * (-a / (b - a)) if b - a > 0.0 else forward(twist)
-        force = self.force_of(tuple(np.asarray(load, dtype=float).tolist()))
-        return tuple(twist.tolist()), force, self.load_of(force)
+        below, above = (np.asarray(forward(on_line(x))).tolist() for x in (s - step, s + step))
+        a, b = _dot(below, turn), _dot(above, turn)
+        if b - a > 0.0:
+            load = tuple(x + (y - x) * (-a / (b - a)) for x, y in zip(below, above, strict=True))
+        else:
+            load = tuple(np.asarray(forward(on_line(s)), dtype=float).tolist())
+        force = self.force_of(load)
+        return tuple(on_line(s).tolist()), force, self.load_of(force)
 
     def force_of(self, load: Vector) -> Vector:
         """The pusher force ``F`` whose load ``Jᵀ F`` is nearest to ``load`` (least squares:
