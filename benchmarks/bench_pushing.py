@@ -72,17 +72,19 @@ def socp_steps_per_second(count: int) -> float:
 
 
 class TimedSurface:
-    """A limit surface whose forward and inverse maps add their time to counters [s]."""
+    """A limit surface whose forward and inverse maps add their time [s] and calls to counters."""
 
     def __init__(self, surface: LimitSurface):
         self.surface = surface
         self.frictionless = surface.frictionless
         self.seconds = {"forward map (load)": 0.0, "inverse map (motion, safety factor)": 0.0}
+        self.calls = dict.fromkeys(self.seconds, 0)
 
     def _timed(self, key, method, argument):
         start = time.perf_counter()
         result = method(argument)
         self.seconds[key] += time.perf_counter() - start
+        self.calls[key] += 1
         return result
 
     def load(self, twist):
@@ -105,9 +107,12 @@ def where_the_time_goes(surface: LimitSurface, count: int) -> None:
     start = time.perf_counter()
     steps_per_second(timed, count)
     total = time.perf_counter() - start
-    parts = {**timed.seconds, "the rest (push_step's own Python)": total}
-    parts["the rest (push_step's own Python)"] -= sum(timed.seconds.values())
-    print("    " + ", ".join(f"{name} {seconds / total:.0%}" for name, seconds in parts.items()))
+    for name, seconds in timed.seconds.items():
+        calls = timed.calls[name]
+        print(f"    {name}: {seconds / total:.0%} ({calls / count:.1f} calls per step, "
+              f"{seconds / calls * 1e6:.1f} us each)")  # fmt: skip
+    rest = total - sum(timed.seconds.values())
+    print(f"    the rest (push_step's own Python, root finding, timers): {rest / total:.0%}")
 
 
 def single_call_microseconds(method, arguments) -> float:
