@@ -272,3 +272,68 @@ def test_a_part_on_support_points_can_pivot_about_one_of_them(contact, normal, v
     assert np.linalg.norm(held) <= share * (1 + 1e-9)
     n = np.asarray(normal) / np.linalg.norm(normal)
     assert n @ jacobian(contact) @ step.twist == pytest.approx(n @ velocity, rel=1e-12)
+
+
+# -- the ellipsoid's closed forms and the checks of the arguments ---------------------------------
+
+#: An asymmetric triangle (tilted ellipsoid, centre of pressure off the origin) at 3 N.
+TRIANGLE = LimitSurface(pressure.polygon([[0, 0], [0.1, 0], [0.02, 0.05]], centered=False),
+                        mu=0.3, normal_force=3.0)  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "model",
+    [Ellipsoid.from_limit_surface(TRIANGLE), FittedEllipsoid.from_limit_surface(TRIANGLE)],
+    ids=["ellipsoid", "fitted-ellipsoid"],
+)
+def test_every_step_on_an_ellipsoid_puts_its_load_on_the_model_along_its_motion(model):
+    # The step's safety factor and twist come from the load matrix in closed form; the model's
+    # own safety_factor and motion (from its normalised gauge) must agree with them.
+    rng = np.random.default_rng(3)
+    modes = set()
+    for _ in range(40):
+        contact = rng.uniform(-0.05, 0.1, 2)
+        normal = rng.normal(size=2)
+        velocity = normal + rng.normal(size=2)
+        step = push_step(model, contact=contact, normal=normal, velocity=velocity,
+                         mu=rng.uniform(0.0, 1.0))  # fmt: skip
+        modes.add(step.mode)
+        if step.mode == "separated":
+            continue
+        assert model.safety_factor(step.load) == pytest.approx(1.0, rel=1e-12)
+        assert angle(step.twist, model.motion(step.load)) < 1e-7
+        np.testing.assert_allclose(jacobian(contact).T @ step.force, step.load, rtol=1e-12)
+    assert {"sticking", "sliding-left", "sliding-right"} <= modes
+
+
+@pytest.mark.parametrize("surface", [DISK, SYMMETRIC["ellipsoid"]], ids=["exact", "ellipsoid"])
+def test_arguments_given_as_lists_tuples_or_arrays_give_the_same_step(surface):
+    reference = push_step(surface, contact=[-0.05, 0.02], normal=[1, 0], velocity=[1.0, 0.3],
+                          mu=0.4)  # fmt: skip
+    for convert in (tuple, np.array, lambda v: np.array(v, dtype=np.float32)):
+        step = push_step(surface, contact=convert([-0.05, 0.02]), normal=convert([1, 0]),
+                         velocity=convert([1.0, 0.3]), mu=0.4)  # fmt: skip
+        assert step.mode == reference.mode
+        np.testing.assert_allclose(step.twist, reference.twist, rtol=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("argument", "value", "words"),
+    [
+        ("velocity", [math.nan, 1.0], ["velocity", "finite"]),
+        ("velocity", [1.0, math.inf], ["velocity", "finite"]),
+        ("velocity", [1.0, 0.0, 0.0], ["velocity", "shape"]),
+        ("contact", [[0.0, 0.0], [1.0, 1.0]], ["contact", "shape"]),
+        ("contact", ["a", "b"], ["contact", "real numbers"]),
+        ("normal", np.array([math.nan, 1.0]), ["normal", "finite"]),
+        ("normal", (0.0, 0.0), ["normal", "nonzero"]),
+    ],
+)
+def test_bad_arguments_of_a_step_raise_an_error_naming_them(argument, value, words):
+    arguments = {"contact": [-0.05, 0.0], "normal": [1.0, 0.0], "velocity": [1.0, 0.0]}
+    arguments[argument] = value
+    for surface in (DISK, SYMMETRIC["ellipsoid"]):
+        with pytest.raises(InvalidArgumentError) as caught:
+            push_step(surface, **arguments, mu=0.3)
+        for word in words:
+            assert word in str(caught.value)

@@ -40,7 +40,10 @@ the facet, as the surface's ``motion`` returns it.
 from __future__ import annotations
 
 import math
+import operator
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from scipy.optimize import brentq
@@ -57,6 +60,21 @@ ANGLE_XTOL = 1e-15
 
 #: A sticking force may exceed the friction cone by this fraction (rounding) and still stick.
 CONE_RTOL = 1e-12
+
+#: Load matrices of this many ellipsoid models are kept: building one costs more than a step.
+_ELLIPSOIDS_KEPT = 64
+
+#: Relative step to either side of the sticking twist where the one-sided loads of a kink of
+#: ``h`` are taken (a support point at rest).
+_KINK_STEP = 1e-9
+
+#: The lever of the contact about the origin is taken at least this long [m] when bracketing the
+#: line of sticking twists (a push at the origin turns the part about itself).
+_MIN_LEVER = 1e-3
+
+_EPS = np.finfo(float).eps
+
+Vector = tuple[float, ...]
 
 
 @dataclass(frozen=True, slots=True)
@@ -120,10 +138,10 @@ def push_step(surface, *, contact, normal, velocity, mu: float) -> PushStep:
         Pusher–part friction coefficient, >= 0.
     """
     geometry = _Geometry.of(surface, contact, normal, mu)
-    velocity = validation.finite_array("velocity", velocity, shape=(2,))
-    push = float(velocity @ geometry.normal)
+    velocity = _pair("velocity", velocity)
+    push = _dot(velocity, geometry.normal)
     if push <= 0.0:
-        return PushStep.separated(float(velocity @ geometry.tangent))
+        return PushStep.separated(_dot(velocity, geometry.tangent))
     # Sticking: through the forward map where the surface has one (then the force found tells
     # the side it slides on if it lies outside the cone), else from the motion cone.
     sticking = geometry.sticking_by_forward_map(velocity)
@@ -134,20 +152,23 @@ def push_step(surface, *, contact, normal, velocity, mu: float) -> PushStep:
     elif geometry.in_cone(sticking[1]):
         side = 0
     else:
-        side = 1 if sticking[1] @ geometry.tangent > 0.0 else -1
+        side = 1 if _dot(sticking[1], geometry.tangent) > 0.0 else -1
     if side == 0:
         twist, force, load = sticking
-        return PushStep(twist=twist, mode="sticking", slip=0.0, force=force, load=load)
+        return PushStep(twist=np.array(twist), mode="sticking", slip=0.0, force=np.array(force),
+                        load=np.array(load))  # fmt: skip
     force = geometry.edge(side)
-    load = geometry.jacobian.T @ force
+    load = geometry.load_of(force)
     twist, scale = geometry.twist_and_scale(load)
-    normal_speed = float(geometry.normal @ geometry.jacobian @ twist)
+    normal_speed = _dot(geometry.normal, geometry.velocity_of(twist))
     if normal_speed <= 0.0:  # pragma: no cover - normality makes it positive
         raise ModelError("the edge force does not drive the part away from the pusher")
-    twist = twist * push / normal_speed
-    slip = float(geometry.tangent @ (velocity - geometry.jacobian @ twist))
-    return PushStep(twist=twist, mode="sliding-left" if side > 0 else "sliding-right", slip=slip,
-                    force=force * scale, load=load * scale)  # fmt: skip
+    twist = _scaled(twist, push / normal_speed)
+    moved = geometry.velocity_of(twist)
+    slip = _dot(geometry.tangent, (velocity[0] - moved[0], velocity[1] - moved[1]))
+    return PushStep(twist=np.array(twist), mode="sliding-left" if side > 0 else "sliding-right",
+                    slip=slip, force=np.array(_scaled(force, scale)),
+                    load=np.array(_scaled(load, scale)))  # fmt: skip
 
 
 def motion_cone(surface, *, contact, normal, mu: float) -> MotionCone:
@@ -158,20 +179,27 @@ def motion_cone(surface, *, contact, normal, mu: float) -> MotionCone:
     twists = []
     for side in (1, -1):
         twist = geometry.unit_twist(geometry.edge(side))
-        twists.append(twist / float(geometry.normal @ geometry.jacobian @ twist))
+        normal_speed = _dot(geometry.normal, geometry.velocity_of(twist))
+        twists.append(np.array(_scaled(twist, 1.0 / normal_speed)))
     return MotionCone(left=twists[0], right=twists[1])
 
 
 @dataclass(frozen=True, slots=True)
 class _Geometry:
-    """A pusher contact on a surface: its frame, friction and the force-to-velocity maps."""
+    """A pusher contact on a surface: its frame, friction and the force-to-velocity maps.
+
+    Vectors are tuples of floats: forces and velocities ``(x, y)``, loads and twists
+    ``(x, y, angular)`` (numpy costs more than the arithmetic at this size).
+    """
 
     surface: object
-    jacobian: np.ndarray  # J (2, 3)
-    normal: np.ndarray
-    tangent: np.ndarray
+    contact: Vector  # c; J = [[1, 0, -cy], [0, 1, cx]]
+    normal: Vector
+    tangent: Vector
     half_angle: float  # atan(mu)
-    ellipsoid: np.ndarray | None  # A of H(L) = L^T A L, when the surface is an ellipsoid
+    ellipsoid: tuple[Vector, ...] | None  # A of H(L) = L^T A L, when the surface is an ellipsoid
+    forward: Callable | None  # the surface's load(twist), when it has one
+    joint: Callable | None  # the surface's motion_and_safety_factor(load), when it has one
 
     @classmethod
     def of(cls, surface, contact, normal, mu) -> _Geometry:
@@ -185,130 +213,177 @@ class _Geometry:
                 "a part on a frictionless support has no quasi-static motion: the smallest push "
                 "accelerates it (give the support friction)"
             )
-        cx, cy = validation.finite_array("contact", contact, shape=(2,))
-        direction = validation.finite_array("normal", normal, shape=(2,))
-        length = float(np.linalg.norm(direction))
+        contact = _pair("contact", contact)
+        nx, ny = _pair("normal", normal)
+        length = math.hypot(nx, ny)
         if length == 0.0:
             raise InvalidArgumentError("normal must be a nonzero 2-vector")
-        direction = direction / length
+        nx, ny = nx / length, ny / length
         mu = validation.nonnegative_scalar("mu", mu)
+        ellipsoid = _ellipsoid_matrix(surface)
         return cls(
             surface=surface,
-            jacobian=np.array([[1.0, 0.0, -cy], [0.0, 1.0, cx]]),
-            normal=direction,
-            tangent=np.array([-direction[1], direction[0]]),
+            contact=contact,
+            normal=(nx, ny),
+            tangent=(-ny, nx),
             half_angle=math.atan(mu),
-            ellipsoid=_ellipsoid_matrix(surface),
+            ellipsoid=ellipsoid,
+            forward=None if ellipsoid is not None else getattr(surface, "load", None),
+            joint=getattr(surface, "motion_and_safety_factor", None),
         )
 
-    def edge(self, side: int) -> np.ndarray:
+    def velocity_of(self, twist: Vector) -> Vector:
+        """``J V``: velocity of the part's contact point under ``twist``."""
+        cx, cy = self.contact
+        return twist[0] - cy * twist[2], twist[1] + cx * twist[2]
+
+    def load_of(self, force: Vector) -> Vector:
+        """``B F = Jᵀ F``: the load of a pusher force about the origin."""
+        cx, cy = self.contact
+        return force[0], force[1], cx * force[1] - cy * force[0]
+
+    def edge(self, side: int) -> Vector:
         """Unit force on the left (``side = 1``) or right (-1) edge of the friction cone."""
         return self.force_at(side * self.half_angle)
 
-    def force_at(self, angle: float) -> np.ndarray:
+    def force_at(self, angle: float) -> Vector:
         """Unit force turned ``angle`` [rad] from the normal towards the tangent."""
-        return math.cos(angle) * self.normal + math.sin(angle) * self.tangent
+        c, s = math.cos(angle), math.sin(angle)
+        (nx, ny), (tx, ty) = self.normal, self.tangent
+        return c * nx + s * tx, c * ny + s * ty
 
-    def unit_twist(self, force: np.ndarray) -> np.ndarray:
+    def unit_twist(self, force: Vector) -> Vector:
         """The part's unit twist under the pusher force direction ``force`` (normality)."""
-        return self.unit_twist_of_load(self.jacobian.T @ force)
+        return self.unit_twist_of_load(self.load_of(force))
 
-    def unit_twist_of_load(self, load: np.ndarray) -> np.ndarray:
+    def unit_twist_of_load(self, load: Vector) -> Vector:
         """The part's unit twist under ``load`` (normality)."""
         if self.ellipsoid is not None:
-            twist = self.ellipsoid @ load
+            twist = tuple(_dot(row, load) for row in self.ellipsoid)
         else:
-            twist = np.asarray(self.surface.motion(load), dtype=float)
-        if not np.all(np.isfinite(twist)):
-            raise ModelError(f"the surface gives no motion for the load {load}")
-        return twist / np.linalg.norm(twist)
+            twist = tuple(np.asarray(self.surface.motion(np.array(load)), dtype=float).tolist())
+        if not all(map(math.isfinite, twist)):
+            raise ModelError(f"the surface gives no motion for the load {np.array(load)}")
+        return _scaled(twist, 1.0 / math.sqrt(_dot(twist, twist)))
 
-    def in_cone(self, force: np.ndarray) -> bool:
+    def safety_factor(self, load: Vector) -> float:
+        """The factor that puts ``load`` on the surface (an ellipsoid's in closed form)."""
+        if self.ellipsoid is not None:
+            quadratic = _dot(load, tuple(_dot(row, load) for row in self.ellipsoid))
+            return self.surface.normal_force / math.sqrt(quadratic)
+        return float(self.surface.safety_factor(np.array(load)))
+
+    def in_cone(self, force: Vector) -> bool:
         """Whether ``force`` lies in the pusher's friction cone (to rounding)."""
-        along = float(force @ self.normal)
-        across = abs(float(force @ self.tangent))
+        along = _dot(force, self.normal)
+        across = abs(_dot(force, self.tangent))
         return along > 0.0 and across <= math.tan(self.half_angle) * along * (1 + CONE_RTOL)
 
-    def twist_and_scale(self, load: np.ndarray) -> tuple[np.ndarray, float]:
+    def twist_and_scale(self, load: Vector) -> tuple[Vector, float]:
         """Unit twist of ``load`` (normality) and the factor that puts ``load`` on the surface."""
-        if self.ellipsoid is not None:
-            return self.unit_twist_of_load(load), float(self.surface.safety_factor(load))
-        if hasattr(self.surface, "motion_and_safety_factor"):
-            twist, scale = self.surface.motion_and_safety_factor(load)
-            twist = np.asarray(twist, dtype=float)
-            return twist / np.linalg.norm(twist), float(scale)
-        return self.unit_twist_of_load(load), float(self.surface.safety_factor(load))
+        if self.ellipsoid is None and self.joint is not None:
+            twist, scale = self.joint(np.array(load))
+            twist = tuple(np.asarray(twist, dtype=float).tolist())
+            return _scaled(twist, 1.0 / math.sqrt(_dot(twist, twist))), float(scale)
+        return self.unit_twist_of_load(load), self.safety_factor(load)
 
-    def sticking_by_forward_map(self, velocity: np.ndarray):
+    def sticking_by_forward_map(self, velocity: Vector):
         """``(twist, force, load)`` of minimum dissipation with ``J V = velocity``, through the
         forward map; ``None`` for surfaces without one."""
-        forward = getattr(self.surface, "load", None)
-        if forward is None or self.ellipsoid is not None:
+        forward = self.forward
+        if forward is None:
             return None
-        start = np.array([velocity[0], velocity[1], 0.0])
-        turn = np.array([-self.jacobian[0, 2], -self.jacobian[1, 2], 1.0])  # (cy, -cx, 1)
+        cx, cy = self.contact
+        vx, vy = velocity
+        turn = (cy, -cx, 1.0)  # N: rotation about the contact point
+
+        def on_line(s: float) -> np.ndarray:  # V_0 + s N
+            return np.array([vx + s * cy, vy - s * cx, s])
 
         def slope(s: float) -> float:
-            return float(np.asarray(forward(start + s * turn)) @ turn)
+            return _dot(np.asarray(forward(on_line(s))).tolist(), turn)
 
-        reach = float(np.linalg.norm(velocity)) / max(float(np.linalg.norm(turn[:2])), 1e-3)
+        reach = math.hypot(vx, vy) / max(math.hypot(cx, cy), _MIN_LEVER)
         low, high = -reach, reach
         while slope(low) > 0.0:
             low *= 2.0
         while slope(high) < 0.0:
             high *= 2.0
-        s = brentq(slope, low, high, xtol=ANGLE_XTOL * reach, rtol=4 * np.finfo(float).eps)
-        twist = start + s * turn
+        s = brentq(slope, low, high, xtol=ANGLE_XTOL * reach, rtol=4 * _EPS)
         # At a kink of h (a support point at rest) the slope jumps across 0: the load is the
         # combination of the one-sided loads whose slope is 0 (a subgradient).
-        step = max(abs(s), reach) * 1e-9
-        below, above = (np.asarray(forward(start + x * turn)) for x in (s - step, s + step))
-        a, b = float(below @ turn), float(above @ turn)
-        load = below + (above - below) * (-a / (b - a)) if b - a > 0.0 else forward(twist)
-        force = np.linalg.lstsq(self.jacobian.T, load, rcond=None)[0]
-        return twist, force, self.jacobian.T @ force
+        step = max(abs(s), reach) * _KINK_STEP
+        below, above = (np.asarray(forward(on_line(x))).tolist() for x in (s - step, s + step))
+        a, b = _dot(below, turn), _dot(above, turn)
+        if b - a > 0.0:
+            load = tuple(x + (y - x) * (-a / (b - a)) for x, y in zip(below, above, strict=True))
+        else:
+            load = tuple(np.asarray(forward(on_line(s)), dtype=float).tolist())
+        force = self.force_of(load)
+        return tuple(on_line(s).tolist()), force, self.load_of(force)
 
-    def edge_velocities(self) -> tuple[np.ndarray, np.ndarray]:
+    def force_of(self, load: Vector) -> Vector:
+        """The pusher force ``F`` whose load ``Jᵀ F`` is nearest to ``load`` (least squares:
+        ``J Jᵀ F = J L``, with ``det J Jᵀ = 1 + |c|²``)."""
+        cx, cy = self.contact
+        jx, jy = load[0] - cy * load[2], load[1] + cx * load[2]
+        det = 1.0 + cx * cx + cy * cy
+        return ((1.0 + cx * cx) * jx + cx * cy * jy) / det, (
+            cx * cy * jx + (1.0 + cy * cy) * jy
+        ) / det
+
+    def edge_velocities(self) -> tuple[Vector, Vector]:
         """Contact velocities of the right and left edge twists."""
-        return tuple(self.jacobian @ self.unit_twist(self.edge(side)) for side in (-1, 1))
+        return tuple(self.velocity_of(self.unit_twist(self.edge(side))) for side in (-1, 1))
 
-    def sticking_in_cone(self, velocity: np.ndarray):
+    def sticking_in_cone(self, velocity: Vector):
         """``(twist, force, load)`` of a pusher that sticks, for ``velocity`` inside the motion
         cone, through the inverse map (or the ellipsoid's closed form)."""
         direction = self.sticking_force(velocity)
         twist = self.unit_twist(direction)
-        moved = self.jacobian @ twist
-        twist = twist * (velocity @ moved) / (moved @ moved)
-        load = self.jacobian.T @ direction
-        scale = float(self.surface.safety_factor(load))
-        return twist, direction * scale, load * scale
+        moved = self.velocity_of(twist)
+        twist = _scaled(twist, _dot(velocity, moved) / _dot(moved, moved))
+        load = self.load_of(direction)
+        scale = self.safety_factor(load)
+        return twist, _scaled(direction, scale), _scaled(load, scale)
 
-    def sticking_force(self, velocity: np.ndarray) -> np.ndarray:
+    def sticking_force(self, velocity: Vector) -> Vector:
         """The unit force whose twist moves the contact point along ``velocity``."""
         if self.ellipsoid is not None:  # closed form: J A J^T F ∝ v_p
-            force = np.linalg.solve(self.jacobian @ self.ellipsoid @ self.jacobian.T, velocity)
-            return force / np.linalg.norm(force)
+            return self._ellipsoid_sticking_force(velocity)
         if self.half_angle == 0.0:
             return self.normal
 
         def turn(angle: float) -> float:
-            moved = self.jacobian @ self.unit_twist(self.force_at(angle))
-            return float(moved[0] * velocity[1] - moved[1] * velocity[0])
+            moved = self.velocity_of(self.unit_twist(self.force_at(angle)))
+            return moved[0] * velocity[1] - moved[1] * velocity[0]
 
         low, high = -self.half_angle, self.half_angle
         if turn(low) == 0.0:
             return self.force_at(low)
         if turn(high) == 0.0:
             return self.force_at(high)
-        return self.force_at(brentq(turn, low, high, xtol=ANGLE_XTOL, rtol=4 * np.finfo(float).eps))
+        return self.force_at(brentq(turn, low, high, xtol=ANGLE_XTOL, rtol=4 * _EPS))
+
+    def _ellipsoid_sticking_force(self, velocity: Vector) -> Vector:
+        """``(J A Jᵀ)⁻¹ v_p``, normalised (Cramer's rule on the 2x2 system)."""
+        cx, cy = self.contact
+        ax = tuple(row[0] - cy * row[2] for row in self.ellipsoid)  # A Jᵀ, first column
+        ay = tuple(row[1] + cx * row[2] for row in self.ellipsoid)
+        k00, k01 = ax[0] - cy * ax[2], ay[0] - cy * ay[2]
+        k10, k11 = ax[1] + cx * ax[2], ay[1] + cx * ay[2]
+        det = k00 * k11 - k01 * k10
+        fx = (k11 * velocity[0] - k01 * velocity[1]) / det
+        fy = (k00 * velocity[1] - k10 * velocity[0]) / det
+        return _scaled((fx, fy), 1.0 / math.hypot(fx, fy))
 
 
-def _side(normal: np.ndarray, right: np.ndarray, left: np.ndarray, velocity: np.ndarray) -> int:
+def _side(normal: Vector, right: Vector, left: Vector, velocity: Vector) -> int:
     """0 when ``velocity`` lies in the cone from ``right`` to ``left`` (counter-clockwise),
     1 beyond its left edge, -1 beyond its right edge; angles are measured from ``normal``."""
 
-    def angle(vector: np.ndarray) -> float:
-        return math.atan2(normal[0] * vector[1] - normal[1] * vector[0], normal @ vector)
+    def angle(vector: Vector) -> float:
+        return math.atan2(normal[0] * vector[1] - normal[1] * vector[0], _dot(normal, vector))
 
     turn = angle(velocity)
     if turn > angle(left):
@@ -318,8 +393,36 @@ def _side(normal: np.ndarray, right: np.ndarray, left: np.ndarray, velocity: np.
     return 0
 
 
-def _ellipsoid_matrix(surface) -> np.ndarray | None:
+def _dot(a: Vector, b: Vector) -> float:
+    return sum(map(operator.mul, a, b))
+
+
+def _scaled(vector: Vector, factor: float) -> Vector:
+    return tuple(x * factor for x in vector)
+
+
+def _pair(name: str, value: object) -> Vector:
+    """``value`` as two finite floats, checked as :func:`validation.finite_array` does (a pair
+    of plain numbers is taken without building an array)."""
+    plain = isinstance(value, list | tuple) and len(value) == 2
+    if plain or (isinstance(value, np.ndarray) and value.shape == (2,) and value.dtype == float):
+        x, y = value
+        if isinstance(x, float | int) and isinstance(y, float | int):
+            x, y = float(x), float(y)
+            if math.isfinite(x) and math.isfinite(y):
+                return x, y
+    x, y = validation.finite_array(name, value, shape=(2,)).tolist()
+    return x, y
+
+
+def _ellipsoid_matrix(surface) -> tuple[Vector, ...] | None:
     """``A`` of an ellipsoid model ``H(L) = L^T A L`` (its normals are ``A L``), else ``None``."""
     if not isinstance(surface, Ellipsoid | FittedEllipsoid) or surface.frictionless:
         return None
-    return surface.load_matrix
+    return _load_matrix(surface)
+
+
+@lru_cache(maxsize=_ELLIPSOIDS_KEPT)
+def _load_matrix(model: Ellipsoid | FittedEllipsoid) -> tuple[Vector, ...]:
+    """The rows of ``model.load_matrix`` (models are immutable: equal models, equal matrices)."""
+    return tuple(tuple(row) for row in model.load_matrix.tolist())

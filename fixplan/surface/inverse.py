@@ -15,6 +15,8 @@ balance it is within its friction limit.
 
 from __future__ import annotations
 
+import math
+import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -132,6 +134,10 @@ def solve(
     ``scale`` multiplies the kernel (``mu * N``), ``units`` = ``(max_force, max_force,
     max_moment)`` normalise the coordinates.
     """
+    points, friction = kernel.facets
+    if len(loads) == 1 and len(points) == 0:
+        safety, twist = _solve_one(kernel, loads[0], units)
+        return InverseResult(safety_factor=np.array([scale * safety]), twist=twist[None, :])
     count = len(loads)
     norm_loads = loads / units
     length = np.linalg.norm(norm_loads, axis=1)
@@ -141,7 +147,6 @@ def solve(
     z = direction / length[:, None]
 
     terms, values = _objective(kernel, scale, units)
-    points, friction = kernel.facets
     stalled = _newton(z, e1, e2, np.arange(count), terms, values, kinks=len(points) > 0)
     safety = values(z)
     on_facet = np.zeros(count, dtype=bool)
@@ -160,6 +165,99 @@ def solve(
     return InverseResult(safety_factor=safety, twist=z / units)
 
 
+def _solve_one(kernel: SupportKernel, load: np.ndarray, units: np.ndarray):
+    """:func:`solve` for one load of a kernel without facets, in scalars: ``(safety factor of
+    the unit-friction kernel, SI twist (3,))``.
+
+    The same damped Newton method as :func:`_newton`, run on SI twists ``V = Z / units``
+    projected onto the plane by ``b = e / units``: ``g·b`` and ``bᵀ H b`` are then the
+    normalised gradient and Hessian of :func:`solve`, so the iterates are the same to rounding.
+    The friction scale only multiplies ``h`` and drops out of every test. Vectors are lists of
+    floats: numpy costs more than the arithmetic at this size.
+    """
+    u = units.tolist()
+    normalised = [x / ux for x, ux in zip(load.tolist(), u, strict=True)]
+    length = math.sqrt(sum(x * x for x in normalised))
+    direction = [x / length for x in normalised]
+    b1, b2 = ([x / ux for x, ux in zip(e, u, strict=True)] for e in _plane_basis_one(direction))
+    twist = [x / (length * ux) for x, ux in zip(direction, u, strict=True)]
+    h, g, hess = _terms_one(kernel, twist)
+    stalled = True
+    for _ in range(INVERSE_MAX_ITERATIONS):
+        (s1, s2), decrement = _newton_step_one(*_projected(g, hess, b1, b2))
+        if decrement <= INVERSE_RTOL**2 * h:
+            stalled = False
+            break
+        step = [s1 * x + s2 * y for x, y in zip(b1, b2, strict=True)]
+        # The full step is tried with the terms of the next iteration: it is nearly always taken.
+        trial = [x + dx for x, dx in zip(twist, step, strict=True)]
+        terms = _terms_one(kernel, trial)
+        # Near the minimum the sufficient decrease is below rounding: full steps are taken.
+        if decrement > QUADRATIC_REGION * h and terms[0] > h - 1e-4 * decrement:
+            t = 0.5
+            for _ in range(_MAX_HALVINGS - 1):
+                trial = [x + t * dx for x, dx in zip(twist, step, strict=True)]
+                if float(kernel.support(np.array([trial]))[0]) <= h - 1e-4 * t * decrement:
+                    break
+                t *= 0.5
+            else:
+                break
+            terms = _terms_one(kernel, trial)
+        twist = trial
+        h, g, hess = terms
+    if stalled:
+        g1, g2 = _projected(g, hess, b1, b2)[:2]
+        if math.hypot(g1, g2) > INVERSE_GRADIENT_RTOL * h:
+            raise _not_converged(load, math.hypot(g1, g2) / h)
+    return h, np.array(twist)
+
+
+def _terms_one(kernel: SupportKernel, twist: list[float]):
+    """``h``, gradient (3 floats) and Hessian (3 rows of 3) of the kernel at one twist."""
+    h, g, hess = kernel.newton_terms(np.array([twist]))
+    return float(h[0]), g[0].tolist(), hess[0].tolist()
+
+
+def _projected(g, hess, b1, b2) -> tuple[float, float, float, float, float]:
+    """``g·b1``, ``g·b2``, ``b1ᵀ H b1``, ``b1ᵀ H b2`` and ``b2ᵀ H b2``."""
+    hb1 = [sum(map(operator.mul, row, b1)) for row in hess]
+    hb2 = [sum(map(operator.mul, row, b2)) for row in hess]
+    return (
+        sum(map(operator.mul, g, b1)),
+        sum(map(operator.mul, g, b2)),
+        sum(map(operator.mul, b1, hb1)),
+        sum(map(operator.mul, b1, hb2)),
+        sum(map(operator.mul, b2, hb2)),
+    )
+
+
+def _plane_basis_one(direction: list[float]) -> tuple[list[float], list[float]]:
+    """:func:`_plane_basis` of one unit ``direction``."""
+    dx, dy, dz = direction
+    axis = min(range(3), key=lambda i: abs(direction[i]))
+    hx, hy, hz = (float(i == axis) for i in range(3))
+    e1 = [dy * hz - dz * hy, dz * hx - dx * hz, dx * hy - dy * hx]
+    norm = math.sqrt(sum(x * x for x in e1))
+    ax, ay, az = (x / norm for x in e1)
+    return [ax, ay, az], [dy * az - dz * ay, dz * ax - dx * az, dx * ay - dy * ax]
+
+
+def _newton_step_one(g1, g2, h11, h12, h22) -> tuple[tuple[float, float], float]:
+    """:func:`_newton_step` of one point from its projected gradient and Hessian: the step in
+    plane coordinates and the decrement."""
+    ridge = 1e-14 * abs(h11 + h22) + 1e-300
+    h11, h22 = h11 + ridge, h22 + ridge
+    det = h11 * h22 - h12 * h12
+    if det > 0.0:
+        s1 = -(h22 * g1 - h12 * g2) / det
+        s2 = -(h11 * g2 - h12 * g1) / det
+        decrement = -(g1 * s1 + g2 * s2)
+        if math.isfinite(decrement) and decrement >= 0.0:
+            return (s1, s2), decrement
+    # Steepest descent where the Hessian is unusable (never at a smooth minimum).
+    return (-g1, -g2), g1 * g1 + g2 * g2
+
+
 def _check_converged(z, e1, e2, loads, terms) -> None:
     """Raise :class:`ConvergenceError` where Newton stopped away from a minimum."""
     if len(z) == 0:
@@ -168,13 +266,18 @@ def _check_converged(z, e1, e2, loads, terms) -> None:
     projected = np.hypot(np.einsum("ij,ij->i", g, e1), np.einsum("ij,ij->i", g, e2))
     bad = np.flatnonzero(projected > INVERSE_GRADIENT_RTOL * h)
     if bad.size:
-        raise ConvergenceError(
-            f"the inverse map did not converge for load {loads[bad[0]].tolist()} (relative "
-            f"gradient {projected[bad[0]] / h[bad[0]]:.2g}). Pressure and friction functions "
-            "must be smooth over the patch: where mu or p jumps or has a kink (two materials, "
-            "a step in pressure), describe each smooth region as its own patch and sum them with "
-            "LimitSurface.combine. Otherwise, please report this load."
-        )
+        raise _not_converged(loads[bad[0]], projected[bad[0]] / h[bad[0]])
+
+
+def _not_converged(load: np.ndarray, relative_gradient: float) -> ConvergenceError:
+    """The error of a load where Newton stopped away from a minimum."""
+    return ConvergenceError(
+        f"the inverse map did not converge for load {load.tolist()} (relative gradient "
+        f"{relative_gradient:.2g}). Pressure and friction functions must be smooth over the "
+        "patch: where mu or p jumps or has a kink (two materials, a step in pressure), describe "
+        "each smooth region as its own patch and sum them with LimitSurface.combine. Otherwise, "
+        "please report this load."
+    )
 
 
 def _facets(kernel, scale, loads, units, z, safety, points, friction, rows) -> np.ndarray:

@@ -12,7 +12,7 @@ steers Newton's method in the inverse map. Kernels are immutable and work in the
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -84,10 +84,10 @@ class PosedKernel(SupportKernel):
 
     local: SupportKernel
     pose: Pose
+    _transform: np.ndarray = field(init=False, repr=False, compare=False)
 
-    @property
-    def _transform(self) -> np.ndarray:
-        return twist_to_local(self.pose)
+    def __post_init__(self):
+        object.__setattr__(self, "_transform", twist_to_local(self.pose))
 
     @property
     def size(self) -> float:

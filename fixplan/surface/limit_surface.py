@@ -29,6 +29,7 @@ the same patch with ``mu = 1`` (:attr:`LimitSurface.friction_shape`), which shri
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable
 
 import numpy as np
@@ -209,12 +210,9 @@ class LimitSurface:
         ``twist`` is ``(3,)`` or ``(K, 3)``, nonzero. For a twist rotating about a point support
         the stationary point carries no force (one point of the facet).
         """
-        twists, single = validation.vector_batch("twist", twist, width=3)
-        zero = ~np.any(twists != 0.0, axis=1)
-        if np.any(zero):
-            raise InvalidArgumentError(
-                f"twist[{int(np.flatnonzero(zero)[0])}] is zero: a body at rest has no sliding load"
-            )
+        twists, single, zero = _vectors("twist", twist)
+        if zero is not None:
+            raise InvalidArgumentError(f"twist[{zero}] is zero: a body at rest has no sliding load")
         loads = self._scale * self._kernel.evaluate(twists)[1]
         return loads[0] if single else loads
 
@@ -229,11 +227,16 @@ class LimitSurface:
     # -- inverse map ------------------------------------------------------------------------
 
     def _inverse(self, load):
-        loads, single = validation.vector_batch("load", load, width=3)
+        loads, single, zero = _vectors("load", load)
         if self._shape is not None:
             # Frictionless: only the load 0 is held; the motion is the limit mu -> 0+.
             safety = np.where(np.any(loads != 0.0, axis=1), 0.0, np.inf)
             return safety, self._shape._inverse(loads)[1], single
+        if single and zero is None:
+            # Solve for a load of unit size (normalised): s(c L) = s(L) / c.
+            size = float(np.max(np.abs(loads[0] / self._units)))
+            result = solve(self._kernel, self._scale, loads / size, self._units)
+            return result.safety_factor / size, result.twist, True
         safety = np.full(len(loads), np.inf)
         twists = np.full((len(loads), 3), np.nan)
         nonzero = np.flatnonzero(np.any(loads != 0.0, axis=1))
@@ -317,6 +320,18 @@ class LimitSurface:
         loads = directions * self._units
         loads = loads * self._inverse(loads)[0][:, None]
         return loads / self._units if normalized else loads
+
+
+def _vectors(name: str, value: object) -> tuple[np.ndarray, bool, int | None]:
+    """:func:`validation.vector_batch` of 3-vectors, and the index of the first zero vector
+    (``None`` if there is none); one finite 3-vector takes a fast path (single queries)."""
+    if isinstance(value, np.ndarray) and value.shape == (3,) and value.dtype == np.float64:
+        entries = value.tolist()
+        if all(map(math.isfinite, entries)):
+            return value[np.newaxis, :], True, None if any(entries) else 0
+    array, single = validation.vector_batch(name, value, width=3)
+    zero = np.flatnonzero(~np.any(array != 0.0, axis=1))
+    return array, single, int(zero[0]) if zero.size else None
 
 
 def _count(name: str, n: object) -> int:

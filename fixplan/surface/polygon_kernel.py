@@ -3,54 +3,121 @@ r"""Closed-form support functions of piecewise-uniform polygonal pressure (polyg
 The moment function ``M(c) = ∫ q |x - c| dA`` of a region with uniform ``q`` is a sum over its
 directed boundary edges of signed triangles with apex at ``c``. For an edge with unit direction
 ``ê``, outward normal ``n``, signed distance ``d = n·(a - c)`` of its line and coordinates
-``t = ê·(x - c)`` along it (``r = sqrt(d² + t²)``):
+``t = ê·(x - c)`` along it (``r = sqrt(d² + t²)``, ``A = asinh(t/|d|)``):
 
 .. math::
 
-   T(c) = \frac{d}{6}\Big[t r + d^2 \operatorname{asinh}\frac{t}{|d|}\Big]_{t_a}^{t_b},\qquad
-   \int_\triangle \hat u \, dA = \frac{d}{2}\Big[d\,n \operatorname{asinh}\frac{t}{|d|}
-   + ê\, r\Big]_{t_a}^{t_b},
+   T(c) = \frac{d}{6}\Big[t r + d^2 A\Big]_{t_a}^{t_b},\qquad
+   \int_\triangle \hat u \, dA = \frac{d}{2}\Big[d A\, n + r\, ê\Big]_{t_a}^{t_b},
 
-with ``∇M = -∫ û dA``. This is exact for any centre of rotation; for far centres (and pure
+with ``∇M = -∫ û dA``. Differentiating the second form (``∂d/∂c = -n``, ``∂t/∂c = -ê``) gives
+the Hessian ``∇²M = ∫ (I - û ûᵀ)/|x - c| dA`` edge by edge,
+
+.. math::
+
+   \frac12\Big[\big(2 d A - \tfrac{d t}{r}\big) n n^T
+   + \big(\tfrac{d^2}{r} + \tfrac{r}{2}\big)(n ê^T + ê n^T)
+   + \tfrac{d t}{r}\, ê ê^T\Big]_{t_a}^{t_b}
+
+(its antisymmetric part ``[r] (ê nᵀ - n êᵀ)/2`` telescopes to zero around every closed boundary
+and is left out; the trace is ``∫ dA/|x - c| = d [A]``). With ``c = (-v_y, v_x)/w`` the support
+function is ``h = |w| M(c)`` and its Hessian ``Pᵀ ∇²M P / |w|``, ``P = [[0, -1, -c_x],
+[1, 0, -c_y]]``. This is exact for any centre of rotation; for far centres (and pure
 translation) the terms cancel, so there a Gauss rule on the patch, exact to machine precision
-because the integrand is analytic there, takes over.
+because the integrand is analytic there, takes over. The sums over edges are compiled with
+numba, like the point kernel.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 
 from fixplan.surface.kernels import SupportKernel
-from fixplan.surface.point_kernel import PointSetKernel
+from fixplan.surface.point_kernel import PointSetKernel, _compiled, _pick
 from fixplan.tolerances import FAR_FIELD_RADII
 
 
-def _edge_terms(starts, ends, weights, centers):
-    """``M`` ``(K,)`` and ``∫ q û dA`` ``(K, 2)`` at ``centers`` ``(K, 2)``."""
-    direction = ends - starts
-    length = np.hypot(direction[:, 0], direction[:, 1])
-    ex, ey = direction[:, 0] / length, direction[:, 1] / length
-    nx, ny = ey, -ex
-    ax = starts[None, :, 0] - centers[:, 0, None]
-    ay = starts[None, :, 1] - centers[:, 1, None]
-    bx = ends[None, :, 0] - centers[:, 0, None]
-    by = ends[None, :, 1] - centers[:, 1, None]
-    d = nx * ax + ny * ay
-    ta = ex * ax + ey * ay
-    tb = ex * bx + ey * by
-    ra, rb = np.hypot(d, ta), np.hypot(d, tb)
-    absd = np.abs(d)
-    safe = np.where(absd > 0.0, absd, 1.0)
-    asinh_diff = np.where(absd > 0.0, np.arcsinh(tb / safe) - np.arcsinh(ta / safe), 0.0)
-    moment = (d / 6.0) * (tb * rb - ta * ra + d * d * asinh_diff)
-    u_integral_n = 0.5 * d * d * asinh_diff
-    u_integral_e = 0.5 * d * (rb - ra)
-    moment_sum = moment @ weights
-    ux = (u_integral_n * nx + u_integral_e * ex) @ weights
-    uy = (u_integral_n * ny + u_integral_e * ey) @ weights
-    return moment_sum, np.column_stack([ux, uy])
+def _edge_sums(  # pragma: no cover - compiled
+    edges, reach, twists, with_hessian, out_h, out_g, out_hess, out_far
+):
+    """Support values ``out_h``, loads ``out_g`` and, ``with_hessian``, Hessians ``out_hess`` of
+    the twists whose centre of rotation lies within ``reach`` [m]; ``out_far`` marks the others
+    (their rows are left unset), whose number is returned. ``edges`` ``(7, E)`` holds the
+    starts' x and y, the ends' x and y, the unit directions' x and y and the weights."""
+    far_count = 0
+    for k in numba.prange(twists.shape[0]):
+        vx, vy, w = twists[k, 0], twists[k, 1], twists[k, 2]
+        far = abs(w) * reach <= math.sqrt(vx * vx + vy * vy)
+        out_far[k] = far
+        if far:
+            far_count += 1
+            continue
+        cx = -vy / w
+        cy = vx / w
+        moment = 0.0
+        ux = 0.0  # ∫ q û dA = -∇M
+        uy = 0.0
+        m00 = 0.0  # ∇²M
+        m01 = 0.0
+        m11 = 0.0
+        for i in range(edges.shape[1]):
+            q = edges[6, i]
+            dx = edges[4, i]
+            dy = edges[5, i]
+            nx = dy
+            ny = -dx
+            ax = edges[0, i] - cx
+            ay = edges[1, i] - cy
+            d = nx * ax + ny * ay
+            ta = dx * ax + dy * ay
+            tb = dx * (edges[2, i] - cx) + dy * (edges[3, i] - cy)
+            ra = math.sqrt(d * d + ta * ta)
+            rb = math.sqrt(d * d + tb * tb)
+            absd = abs(d)
+            asinh_diff = math.asinh(tb / absd) - math.asinh(ta / absd) if absd > 0.0 else 0.0
+            moment += q * (d / 6.0) * (tb * rb - ta * ra + d * d * asinh_diff)
+            u_n = q * 0.5 * d * d * asinh_diff
+            u_e = q * 0.5 * d * (rb - ra)
+            ux += u_n * nx + u_e * dx
+            uy += u_n * ny + u_e * dy
+            if with_hessian:
+                # t/r and 1/r vanish with d at the vertex itself (r = 0): |d t/r|, d²/r <= |d|.
+                inv_ra = 1.0 / ra if ra > 0.0 else 0.0
+                inv_rb = 1.0 / rb if rb > 0.0 else 0.0
+                c_ee = d * (tb * inv_rb - ta * inv_ra)
+                c_nn = 2.0 * d * asinh_diff - c_ee
+                c_ne = d * d * (inv_rb - inv_ra) + 0.5 * (rb - ra)
+                m00 += 0.5 * q * (c_nn * nx * nx + 2.0 * c_ne * nx * dx + c_ee * dx * dx)
+                m01 += 0.5 * q * (c_nn * nx * ny + c_ne * (nx * dy + dx * ny) + c_ee * dx * dy)
+                m11 += 0.5 * q * (c_nn * ny * ny + 2.0 * c_ne * ny * dy + c_ee * dy * dy)
+        sign = 1.0 if w > 0.0 else -1.0
+        gx = -ux
+        gy = -uy
+        out_h[k] = abs(w) * moment
+        out_g[k, 0] = sign * gy
+        out_g[k, 1] = -sign * gx
+        out_g[k, 2] = sign * (moment - cx * gx - cy * gy)
+        if with_hessian:
+            s = 1.0 / abs(w)
+            out_hess[k, 0, 0] = s * m11
+            out_hess[k, 0, 1] = -s * m01
+            out_hess[k, 1, 0] = -s * m01
+            out_hess[k, 1, 1] = s * m00
+            h02 = -s * (m01 * cx + m11 * cy)
+            h12 = s * (m00 * cx + m01 * cy)
+            out_hess[k, 0, 2] = h02
+            out_hess[k, 2, 0] = h02
+            out_hess[k, 1, 2] = h12
+            out_hess[k, 2, 1] = h12
+            out_hess[k, 2, 2] = s * (m00 * cx * cx + 2.0 * m01 * cx * cy + m11 * cy * cy)
+    return far_count
+
+
+_EDGE_SUMS = _compiled(_edge_sums)
 
 
 @dataclass(frozen=True, slots=True)
@@ -66,30 +133,49 @@ class EdgeSumKernel(SupportKernel):
     ends: np.ndarray
     weights: np.ndarray
     far: PointSetKernel
+    _edges: np.ndarray = field(init=False, repr=False)
+    _size: float = field(init=False, repr=False)
+
+    def __post_init__(self):
+        starts = np.asarray(self.starts, dtype=float)
+        ends = np.asarray(self.ends, dtype=float)
+        direction = ends - starts
+        length = np.hypot(direction[:, 0], direction[:, 1])
+        columns = (starts, ends, direction / length[:, None], np.asarray(self.weights, dtype=float))
+        edges = np.ascontiguousarray(np.column_stack(columns).T)
+        object.__setattr__(self, "_edges", edges)
+        object.__setattr__(self, "_size", self.far.size)
 
     @property
     def size(self) -> float:
-        return self.far.size
+        return self._size
+
+    def _sums(self, twists, with_hessian):
+        twists = np.ascontiguousarray(twists, dtype=float)
+        count = len(twists)
+        h = np.empty(count)
+        g = np.empty((count, 3))
+        hess = np.empty((count if with_hessian else 0, 3, 3))
+        far = np.empty(count, dtype=np.bool_)
+        far_count = _pick(_EDGE_SUMS, count, len(self.weights))(
+            self._edges, FAR_FIELD_RADII * self._size, twists, with_hessian, h, g, hess, far
+        )
+        return twists, far if far_count else None, h, g, hess
 
     def evaluate(self, twists):
-        vx, vy, w = twists[:, 0], twists[:, 1], twists[:, 2]
-        far = np.abs(w) * FAR_FIELD_RADII * self.size <= np.hypot(vx, vy)
-        h = np.empty(len(twists))
-        loads = np.empty((len(twists), 3))
-        if np.any(far):
+        twists, far, h, loads, _ = self._sums(twists, False)
+        if far is not None:
             h[far], loads[far] = self.far.evaluate(twists[far])
-        near = ~far
-        if np.any(near):
-            wn = w[near]
-            centers = np.column_stack([-vy[near] / wn, vx[near] / wn])
-            moment, u_integral = _edge_terms(self.starts, self.ends, self.weights, centers)
-            grad = -u_integral  # ∇M(c)
-            sign = np.sign(wn)
-            h[near] = np.abs(wn) * moment
-            loads[near, 0] = sign * grad[:, 1]
-            loads[near, 1] = -sign * grad[:, 0]
-            loads[near, 2] = sign * (moment - np.einsum("ij,ij->i", centers, grad))
         return h, loads
+
+    def newton_terms(self, twists):
+        twists, far, h, g, hess = self._sums(twists, True)
+        if far is not None:
+            h[far], g[far], hess[far] = self.far.newton_terms(twists[far])
+        return h, g, hess
+
+    def hessian(self, twists):
+        return self.newton_terms(twists)[2]
 
 
 def polygon_edges(vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
