@@ -111,7 +111,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--limit", type=int, help="only the first N test pushes of each group")
     args = parser.parse_args(argv)
     failed = []
-    print("pushing with Zhou's ellipsoid and pusher friction (MIT push dataset, ABS sheet);")
+    print("pushing with Zhou's ellipsoid and pusher friction (MIT push dataset);")
     print("errors are mean final-pose differences over the group's test pushes")
     print(f"{'group':12s} {'pushes':>6s} {'moved':>14s} {'fixplan-Zhou':>16s} {'fixplan-meas.':>16s}"
           f" {'Zhou-meas.':>16s}" + (f" {'no fit-meas.':>16s}" if args.no_fit else ""))  # fmt: skip

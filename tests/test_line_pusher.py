@@ -12,7 +12,7 @@ from scipy.optimize import brentq, nnls
 
 from fixplan import Contact, ContactSetSurface, LimitSurface, pressure
 from fixplan.errors import InvalidArgumentError
-from fixplan.models import Ellipsoid, Exact
+from fixplan.models import Cone, Ellipsoid, Exact
 from fixplan.motion import LinePusher, Outline, line_push_step, push
 
 SUPPORT = LimitSurface(pressure.rectangle(0.1, 0.06), mu=0.4, normal_force=5.0)
@@ -28,12 +28,12 @@ def jacobian(point):
 
 def translation_load(surface, velocity):
     """The load on the surface that sustains the translation ``velocity``: for the ellipsoid
-    L^T A L = 1 the point whose normal A L is parallel to (v, 0); for the exact surface its
+    L^T A L = N² the point whose normal A L is parallel to (v, 0); for the exact surface its
     forward map."""
     twist = np.array([velocity[0], velocity[1], 0.0])
     if isinstance(surface, Ellipsoid):
         load = np.linalg.solve(surface.load_matrix, twist)
-        return load / math.sqrt(load @ surface.load_matrix @ load)
+        return load * surface.normal_force / math.sqrt(load @ surface.load_matrix @ load)
     return surface.load(twist)
 
 
@@ -169,6 +169,7 @@ def test_two_point_steps_agree_with_the_cones_of_edge_wrenches(name, case):
         assert n @ jacobian(other) @ step.twist > n @ velocity
         return
     assert step.mode == mode and len(bearing) == 2
+    assert surface.safety_factor(step.load) == pytest.approx(1.0, rel=1e-9)  # on the surface
     np.testing.assert_allclose(step.twist, [moving[0], moving[1], 0.0], rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(step.load, load, rtol=1e-9, atol=1e-12 * np.abs(load).max())
     np.testing.assert_allclose(step.force, load[:2], rtol=1e-9)
@@ -400,12 +401,12 @@ def test_bad_line_pusher_arguments_are_refused():
     with pytest.raises(InvalidArgumentError, match="PointPusher or a LinePusher"):
         push(SUPPORT, "pusher", shape=BLOCK, duration=1.0, steps=5)
     with pytest.raises(InvalidArgumentError, match="forward map"):
-        line_push_step(Exact.from_limit_surface(SUPPORT), contacts=FACE, normal=[1, 0],
+        line_push_step(Cone.from_limit_surface(SUPPORT), contacts=FACE, normal=[1, 0],
                        velocity=[1, 0], mu=0.3)  # fmt: skip
     with pytest.raises(InvalidArgumentError, match="two points apart"):
         line_push_step(SUPPORT, contacts=[[-0.05, 0.0], [-0.05, 0.0]], normal=[1, 0],
                        velocity=[1, 0], mu=0.3)  # fmt: skip
-    with pytest.raises(InvalidArgumentError, match="frictionless support"):
+    with pytest.raises(InvalidArgumentError, match="frictionless"):
         line_push_step(LimitSurface(pressure.disk(0.05), mu=0.0), contacts=FACE, normal=[1, 0],
                        velocity=[1, 0], mu=0.3)  # fmt: skip
 
@@ -415,3 +416,16 @@ def test_a_face_moving_away_leaves_the_part_at_rest():
                                    mu=0.3)  # fmt: skip
     assert step.mode == "separated" and not len(bearing) and not np.any(step.twist)
     assert step.slip == 0.2
+
+
+@pytest.mark.parametrize("velocity", [[1.0, 0.0], [1.0, 0.5], [1.0, -0.8]])
+def test_the_exact_model_steps_like_the_limit_surface_it_discretises(velocity):
+    # The planner's Exact model is a 128-disk quadrature of the same field: the same mode, and
+    # the twist to the quadrature's accuracy (about 3e-4).
+    model = Exact.from_limit_surface(SUPPORT)
+    ours, _ = line_push_step(model, contacts=FACE, normal=[1, 0], velocity=velocity, mu=0.3)
+    exact, _ = line_push_step(SUPPORT, contacts=FACE, normal=[1, 0], velocity=velocity, mu=0.3)
+    assert ours.mode == exact.mode
+    np.testing.assert_allclose(
+        ours.twist, exact.twist, rtol=1e-3, atol=1e-3 * np.abs(exact.twist).max()
+    )

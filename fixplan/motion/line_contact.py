@@ -49,6 +49,7 @@ from scipy.optimize import brentq
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError, ModelError
 from fixplan.models.ellipsoid import Ellipsoid, FittedEllipsoid
+from fixplan.motion.forward_map import ForwardMap, forward_map
 from fixplan.motion.pushing import ANGLE_XTOL, CONE_RTOL, PushStep, push_step
 
 #: The line of action of a two-point load may pass beyond an end of the contact segment by this
@@ -68,9 +69,9 @@ def line_push_step(
     Parameters
     ----------
     surface
-        The support's limit surface, with the load of a translation: a forward map
-        ``load(twist)`` (:class:`~fixplan.LimitSurface`, :class:`~fixplan.ContactSetSurface`) or
-        an ellipsoid model (:class:`~fixplan.models.Ellipsoid`, ``FittedEllipsoid``).
+        The support's limit surface, with a forward map (the load of a translation):
+        :class:`~fixplan.LimitSurface`, :class:`~fixplan.ContactSetSurface`, or the models
+        :class:`~fixplan.models.Ellipsoid`, ``FittedEllipsoid`` and ``Exact``.
     contacts : array_like
         ``(2, 2)`` the two contact points on the part [m], in the surface's frame, on a line
         perpendicular to ``normal``.
@@ -147,42 +148,24 @@ def _flush(translations, right, left, normal, velocity, mu) -> tuple[PushStep | 
 
 
 class _Translations:
-    """The loads of a surface's translations ``(v, 0)``: by its forward map or, for an
-    ellipsoid ``L^T A L = 1``, in closed form."""
+    """The loads of a surface's translations ``(v, 0)``: by its forward map
+    (:func:`~fixplan.motion.forward_map.forward_map`), with the ellipsoid's closed form for the
+    translation whose load has a given force direction."""
 
-    def __init__(self, surface, inverse: np.ndarray | None):
-        self._surface = surface
-        self._inverse = inverse  # A^{-1} of an ellipsoid
+    def __init__(self, forward: ForwardMap, inverse: np.ndarray | None):
+        self._forward = forward
+        self._inverse = inverse  # A^{-1} of an ellipsoid H(L) = L^T A L
 
     @classmethod
     def of(cls, surface) -> _Translations:
-        if not (hasattr(surface, "motion") and hasattr(surface, "safety_factor")):
-            raise InvalidArgumentError(
-                f"surface must have the limit-surface interface (motion, safety_factor), got "
-                f"{type(surface).__name__}"
-            )
-        if getattr(surface, "frictionless", False):
-            raise InvalidArgumentError(
-                "a part on a frictionless support has no quasi-static motion: the smallest push "
-                "accelerates it (give the support friction)"
-            )
+        forward = forward_map(surface)
         if isinstance(surface, Ellipsoid | FittedEllipsoid):
-            return cls(surface, np.linalg.inv(surface.load_matrix))
-        if not hasattr(surface, "load"):
-            raise InvalidArgumentError(
-                "a flat pusher touching at two points needs the load of a translation: give a "
-                "surface with a forward map load(twist) (LimitSurface, ContactSetSurface) or an "
-                f"ellipsoid model; got {type(surface).__name__}"
-            )
-        return cls(surface, None)
+            return cls(forward, np.linalg.inv(surface.load_matrix))
+        return cls(forward, None)
 
     def load(self, velocity: np.ndarray) -> np.ndarray:
         """The load on the surface that sustains the translation ``velocity``."""
-        twist = np.array([velocity[0], velocity[1], 0.0])
-        if self._inverse is None:
-            return np.asarray(self._surface.load(twist), dtype=float)
-        load = self._inverse @ twist
-        return load / math.sqrt(load @ twist)
+        return np.asarray(self._forward.load(np.array([velocity[0], velocity[1], 0.0])), float)
 
     def sliding(self, edge: np.ndarray, normal: np.ndarray, velocity: np.ndarray, side: int):
         """The translation at the normal speed of ``velocity`` whose load's force is parallel to
