@@ -236,20 +236,20 @@ class _ShapeTable:
     """The nominal gauge ``g0``, power share ``s`` and normal elevation ``θ_n`` over directions.
 
     Nodes at elevations ``θ_q`` in ``[0, π/2]`` (``n`` steps) and azimuths in ``[-π, π]``
-    (``4 n`` steps) of unit normalised loads; stored as flat lists (a list read costs a tenth
-    of a NumPy scalar read, and the update is pure Python arithmetic).
+    (``4 n`` steps) of unit normalised loads. Each cell keeps the coefficients
+    ``(a, b, c, d)`` of ``a + b u + c v + d u v`` (``u``, ``v`` in ``[0, 1]`` across the cell)
+    of the three quantities in one list: the update is pure Python arithmetic, where a list read
+    costs a tenth of a NumPy scalar read.
     """
 
-    __slots__ = ("_azimuth_step", "_elevation_step", "_gauge", "_normal", "_share", "_steps",
-                 "_width")  # fmt: skip
+    __slots__ = ("_azimuth_step", "_cells", "_elevation_step", "_steps", "_width")
 
     def __init__(self, nominal, *, units: np.ndarray, center: tuple[float, float], steps: int):
         azimuths = np.linspace(-np.pi, np.pi, 4 * steps + 1)
         elevations = np.linspace(0.0, 0.5 * np.pi, steps + 1)
-        elevation, azimuth = (grid.ravel() for grid in np.meshgrid(elevations, azimuths,
-                                                                   indexing="ij"))  # fmt: skip
-        q = np.column_stack([np.cos(elevation) * np.cos(azimuth),
-                             np.cos(elevation) * np.sin(azimuth), np.sin(elevation)])  # fmt: skip
+        elevation, azimuth = np.meshgrid(elevations, azimuths, indexing="ij")
+        q = np.stack([np.cos(elevation) * np.cos(azimuth), np.cos(elevation) * np.sin(azimuth),
+                      np.sin(elevation)], axis=-1).reshape(-1, 3)  # fmt: skip
         cx, cy = center
         loads = q * units
         loads[:, 2] += cx * loads[:, 1] - cy * loads[:, 0]  # moments about the origin
@@ -261,12 +261,17 @@ class _ShapeTable:
         normal = np.column_stack([twists[:, 0] - cy * twists[:, 2],
                                   twists[:, 1] + cx * twists[:, 2],
                                   units[2] / units[0] * twists[:, 2]])  # fmt: skip
-        share = normal[:, 2] * q[:, 2] / np.einsum("ij,ij->i", normal, q)
-        self._gauge = (1.0 / safety).tolist()
-        self._share = share.tolist()
-        self._normal = np.arctan2(normal[:, 2], np.hypot(normal[:, 0], normal[:, 1])).tolist()
+        nodes = np.column_stack([
+            1.0 / safety,
+            normal[:, 2] * q[:, 2] / np.einsum("ij,ij->i", normal, q),
+            np.arctan2(normal[:, 2], np.hypot(normal[:, 0], normal[:, 1])),
+        ]).reshape(steps + 1, 4 * steps + 1, 3)  # fmt: skip
+        f00, f10 = nodes[:-1, :-1], nodes[:-1, 1:]
+        f01, f11 = nodes[1:, :-1], nodes[1:, 1:]
+        cells = np.stack([f00, f10 - f00, f01 - f00, f11 - f10 - f01 + f00], axis=-1)
+        self._cells = cells.reshape(-1, 12).tolist()
         self._steps = steps
-        self._width = 4 * steps + 1
+        self._width = 4 * steps
         self._azimuth_step = 4 * steps / (2.0 * math.pi)
         self._elevation_step = steps / (0.5 * math.pi)
 
@@ -276,23 +281,15 @@ class _ShapeTable:
         elevation = math.atan2(qm, radius)
         x = (math.atan2(qy, qx) + math.pi) * self._azimuth_step
         y = elevation * self._elevation_step
-        i = min(int(x), self._width - 2)
+        i = min(int(x), self._width - 1)
         j = min(int(y), self._steps - 1)
         u = x - i
         v = y - j
-        k = j * self._width + i
-        up = k + self._width
-        w00, w10, w01, w11 = (1.0 - u) * (1.0 - v), u * (1.0 - v), (1.0 - u) * v, u * v
-        values = self._gauge
-        gauge = w00 * values[k] + w10 * values[k + 1] + w01 * values[up] + w11 * values[up + 1]
-        values = self._share
-        share = w00 * values[k] + w10 * values[k + 1] + w01 * values[up] + w11 * values[up + 1]
-        values = self._normal
-        low = (1.0 - u) * values[k] + u * values[k + 1]
-        high = (1.0 - u) * values[up] + u * values[up + 1]
-        gauge *= math.sqrt(radius * radius + qm * qm)
-        slope = (high - low) * self._elevation_step
-        return gauge, share, low + v * (high - low), slope, elevation
+        g, gu, gv, guv, s, su, sv, suv, t, tu, tv, tuv = self._cells[j * self._width + i]
+        tv += tuv * u
+        gauge = (g + gu * u + (gv + guv * u) * v) * math.sqrt(radius * radius + qm * qm)
+        share = s + su * u + (sv + suv * u) * v
+        return gauge, share, t + tu * u + tv * v, tv * self._elevation_step, elevation
 
 
 class SlipEstimator:
