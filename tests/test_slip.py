@@ -12,7 +12,7 @@ import pytest
 from fixplan import LimitSurface, pressure
 from fixplan.errors import InvalidArgumentError
 from fixplan.models import Cone, Ellipsoid
-from fixplan.motion import ScaledSurface, SlipEstimator, push_step
+from fixplan.motion import ScaledSurface, SlipEstimator, push_step, slide
 
 MU, RADIUS = 0.5, 0.02
 RECTANGLE = (0.1, 0.01)  # 10:1 [m]
@@ -241,6 +241,10 @@ def test_the_estimated_surface_agrees_with_the_true_surface():
     pushed, reference = push_step(surface, **step), push_step(true, **step)
     assert pushed.mode == reference.mode
     assert np.linalg.norm(pushed.twist - reference.twist) < 0.02 * np.linalg.norm(reference.twist)
+    # Free sliding through the forward map: where the body comes to rest.
+    sliding = {"mass": 1.0, "inertia": 1e-3, "twist0": [0.5, 0.1, 5.0], "duration": 0.3}
+    rest, reference_rest = slide(surface, **sliding).poses[-1], slide(true, **sliding).poses[-1]
+    np.testing.assert_allclose(rest, reference_rest, rtol=0.01)
 
 
 def test_an_ellipsoid_nominal_converges_to_the_true_ellipsoid():
