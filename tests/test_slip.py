@@ -11,7 +11,7 @@ import pytest
 
 from fixplan import LimitSurface, pressure
 from fixplan.errors import InvalidArgumentError
-from fixplan.models import Cone, Ellipsoid
+from fixplan.models import Cone, Ellipsoid, FittedEllipsoid
 from fixplan.motion import ScaledSurface, SlipEstimator, push_step, slide
 
 MU, RADIUS = 0.5, 0.02
@@ -51,9 +51,10 @@ def onsets(true, count, *, seed, noise=FORCE_NOISE, twist_noise=0.0):
     """Slip onsets on ``true``: loads of random twists at random normal forces, with relative
     force noise per component and twist noise in the normalised twist ``(vx, vy, rho w)``."""
     rng = np.random.default_rng(seed)
-    rho = true.rho if isinstance(true, Ellipsoid) else true.characteristic_length
+    ellipsoidal = isinstance(true, Ellipsoid | FittedEllipsoid)
+    rho = true.rho if ellipsoidal else true.characteristic_length
     twists = rng.normal(size=(count, 3)) / np.array([1.0, 1.0, rho])
-    unit = ellipsoid_loads(true, twists) if isinstance(true, Ellipsoid) else true.load(twists)
+    unit = ellipsoid_loads(true, twists) if ellipsoidal else true.load(twists)
     normal_forces = rng.uniform(2.0, 20.0, count)
     loads = unit * normal_forces[:, None] * (1.0 + noise * rng.normal(size=(count, 3)))
     twists = twists / np.linalg.norm(twists * np.array([1.0, 1.0, rho]), axis=1, keepdims=True)
@@ -247,15 +248,23 @@ def test_the_estimated_surface_agrees_with_the_true_surface():
     np.testing.assert_allclose(rest, reference_rest, rtol=0.01)
 
 
-def test_an_ellipsoid_nominal_converges_to_the_true_ellipsoid():
-    shape = {"tilt": (0.1, -0.05), "center": (0.01, 0.004), "normal_force": 3.0}
-    true = Ellipsoid(mu=0.4, rho=0.012, **shape)
-    nominal = Ellipsoid(mu=0.8, rho=0.007, **shape)
+TILTED = {"tilt": (0.1, -0.05), "center": (0.01, 0.004), "normal_force": 3.0}
+FITTED_MATRIX = [[1.1, 0.1, 0.2], [0.1, 0.9, -0.1], [0.2, -0.1, 1.2]]
+
+
+@pytest.mark.parametrize(
+    ("model", "shape"),
+    [(Ellipsoid, TILTED), (FittedEllipsoid, {"matrix": FITTED_MATRIX, "center": (-0.01, 0.0)})],
+)
+def test_an_ellipsoid_nominal_converges_to_the_true_ellipsoid(model, shape):
+    true = model(mu=0.4, rho=0.012, **shape)
+    nominal = model(mu=0.8, rho=0.007, **shape)
     samples = onsets(true, 400, seed=9, twist_noise=math.radians(5.0))
     estimator = feed(SlipEstimator(nominal, twist_noise=math.radians(5.0)), samples, twists=True)
     surface = estimator.surface
-    assert isinstance(surface, Ellipsoid)
-    assert (surface.tilt, surface.center, surface.normal_force) == tuple(shape.values())
+    assert isinstance(surface, model)
+    for name, value in shape.items():
+        assert np.array_equal(getattr(surface, name), value)
     assert surface.mu == pytest.approx(0.4, rel=0.01)
     assert surface.rho == pytest.approx(0.012, rel=0.01)
 
