@@ -1,4 +1,5 @@
-"""Layer 4: how a part moves (paper §4.3) — pushing, pivoting and sliding.
+"""Layer 4: how a part moves (paper §4.3) — pushing, pivoting and sliding — and limit surfaces
+updated from slip onsets.
 
 Built on the limit surfaces and models of the layers below, without changing their conventions;
 imports only from :mod:`fixplan.planner`, :mod:`fixplan.models`, :mod:`fixplan.surface` and the
@@ -11,6 +12,7 @@ from fixplan.motion.pivoting import Settling, settle
 from fixplan.motion.pushers import LinePusher, PointPusher
 from fixplan.motion.pushing import MotionCone, PushStep, motion_cone, push_step
 from fixplan.motion.sliding import Sliding, slide, start_acceleration
+from fixplan.motion.slip import ScaledSurface, SlipEstimator
 from fixplan.motion.trajectory import Trajectory, push
 
 __all__ = [
@@ -20,8 +22,10 @@ __all__ = [
     "Outline",
     "PointPusher",
     "PushStep",
+    "ScaledSurface",
     "Settling",
     "Sliding",
+    "SlipEstimator",
     "Trajectory",
     "line_push_step",
     "motion_cone",
