@@ -5,6 +5,16 @@ imports only from :mod:`fixplan.planner`, :mod:`fixplan.models`, :mod:`fixplan.s
 top-level modules.
 """
 
+from fixplan.motion.fitted_quartic import FittedQuartic
+from fixplan.motion.identify import (
+    Fit,
+    FitErrors,
+    FitReport,
+    assess,
+    ellipsoid_from_matrix,
+    fit,
+    synthetic,
+)
 from fixplan.motion.line_contact import line_push_step
 from fixplan.motion.outline import FacePoints, Outline
 from fixplan.motion.pivoting import Settling, settle
@@ -15,6 +25,10 @@ from fixplan.motion.trajectory import Trajectory, push
 
 __all__ = [
     "FacePoints",
+    "Fit",
+    "FitErrors",
+    "FitReport",
+    "FittedQuartic",
     "LinePusher",
     "MotionCone",
     "Outline",
@@ -23,6 +37,9 @@ __all__ = [
     "Settling",
     "Sliding",
     "Trajectory",
+    "assess",
+    "ellipsoid_from_matrix",
+    "fit",
     "line_push_step",
     "motion_cone",
     "push",
@@ -30,4 +47,5 @@ __all__ = [
     "settle",
     "slide",
     "start_acceleration",
+    "synthetic",
 ]
