@@ -315,7 +315,9 @@ class FittedQuartic:
         u = twists * np.array([1.0, 1.0, self.rho])
         values = np.zeros(len(u))
         moving = np.any(u != 0.0, axis=1)
-        values[moving] = np.einsum("ij,ij->i", u[moving], self._surface_points(u[moving]))
+        values[moving] = np.einsum(
+            "ij,ij->i", u[moving], _surface_points(self._evaluate, u[moving])
+        )
         return float(values[0]) if single else values
 
     def load(self, twist) -> np.ndarray:
@@ -325,56 +327,9 @@ class FittedQuartic:
         if not np.all(np.any(twists != 0.0, axis=1)):
             zero = int(np.flatnonzero(~np.any(twists != 0.0, axis=1))[0])
             raise InvalidArgumentError(f"twist[{zero}] is zero: a body at rest has no sliding load")
-        points = self._surface_points(twists * np.array([1.0, 1.0, self.rho]))
+        points = _surface_points(self._evaluate, twists * np.array([1.0, 1.0, self.rho]))
         loads = points * np.array([1.0, 1.0, self.rho])
         return loads[0] if single else loads
-
-    def _surface_points(self, u: np.ndarray) -> np.ndarray:
-        """Points ``x`` ``(K, 3)`` with ``H(x) = 1`` and ``∇H(x) ∝ u`` (``u`` nonzero)."""
-        direction = u / np.linalg.norm(u, axis=1, keepdims=True)
-        x = direction * self._evaluate(direction)[0][:, None] ** -0.25
-        target = direction * np.linalg.norm(self._evaluate(x)[1], axis=1, keepdims=True)
-        active = np.arange(len(x))
-        for _ in range(NEWTON_MAX_ITERATIONS):
-            values, gradients, hessians = self._evaluate(x[active], hessian=True)
-            residual = gradients - target[active]
-            done = np.linalg.norm(residual, axis=1) <= NEWTON_RTOL * np.linalg.norm(
-                target[active], axis=1
-            )
-            active, values, residual, hessians = (
-                active[~done],
-                values[~done],
-                residual[~done],
-                hessians[~done],
-            )
-            if active.size == 0:
-                break
-            step = -np.linalg.solve(hessians, residual[:, :, None])[:, :, 0]
-            x[active] = x[active] + self._damped(x[active], step, values, residual, target[active])
-        else:
-            raise ConvergenceError(
-                f"Newton's method on the quartic's forward map did not converge in "
-                f"{NEWTON_MAX_ITERATIONS} iterations for twists u = {u[active[:3]].tolist()}"
-            )
-        return x / self._evaluate(x)[0][:, None] ** 0.25
-
-    def _damped(self, x, step, values, residual, target) -> np.ndarray:
-        """``t * step`` with ``t`` halved until ``F = H - target · x`` decreases enough (Armijo)
-        or, near the solution where ``F`` is flat to rounding, the residual does."""
-        objective = values - np.einsum("ij,ij->i", target, x)
-        slope = np.einsum("ij,ij->i", residual, step)
-        size = np.linalg.norm(residual, axis=1)
-        scale = np.ones(len(x))
-        for _ in range(_MAX_HALVINGS):
-            trial = x + scale[:, None] * step
-            new, gradients, _ = self._evaluate(trial)
-            new = new - np.einsum("ij,ij->i", target, trial)
-            closer = np.linalg.norm(gradients - target, axis=1) < size
-            short = (new > objective + _ARMIJO * scale * slope) & ~closer
-            if not np.any(short):
-                break
-            scale[short] *= 0.5
-        return scale[:, None] * step
 
     def _largest_force(self) -> float:
         """Largest force [N] (the support of pure translations ``(cos a, sin a, 0)``), root
@@ -416,3 +371,51 @@ def _count(n: object) -> int:
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
         raise InvalidArgumentError(f"n must be a positive integer, got {n!r}")
     return int(n)
+
+
+def _surface_points(evaluate, u: np.ndarray) -> np.ndarray:
+    """Points ``x`` ``(K, 3)`` with ``H(x) = 1`` and ``∇H(x) ∝ u`` (``u`` nonzero): damped
+    Newton on ``∇H(x) = t``, ``t ∝ u`` as large as ``∇H`` at the start, i.e. the minimiser of
+    the convex ``H(x) - t · x``, then scaled onto the level set. ``evaluate`` is
+    :meth:`FittedQuartic._evaluate`."""
+    direction = u / np.linalg.norm(u, axis=1, keepdims=True)
+    x = direction * evaluate(direction)[0][:, None] ** -0.25
+    target = direction * np.linalg.norm(evaluate(x)[1], axis=1, keepdims=True)
+    active = np.arange(len(x))
+    for _ in range(NEWTON_MAX_ITERATIONS):
+        values, gradients, hessians = evaluate(x[active], hessian=True)
+        residual = gradients - target[active]
+        size = np.linalg.norm(target[active], axis=1)
+        moving = np.linalg.norm(residual, axis=1) > NEWTON_RTOL * size
+        active, values, residual, hessians = (
+            active[moving], values[moving], residual[moving], hessians[moving]
+        )  # fmt: skip
+        if active.size == 0:
+            break
+        step = -np.linalg.solve(hessians, residual[:, :, None])[:, :, 0]
+        x[active] += _damped(evaluate, x[active], step, values, residual, target[active])
+    else:
+        raise ConvergenceError(
+            f"Newton's method on the quartic's forward map did not converge in "
+            f"{NEWTON_MAX_ITERATIONS} iterations for twists u = {u[active[:3]].tolist()}"
+        )
+    return x / evaluate(x)[0][:, None] ** 0.25
+
+
+def _damped(evaluate, x, step, values, residual, target) -> np.ndarray:
+    """``t * step`` with ``t`` halved until ``F = H - target · x`` decreases enough (Armijo)
+    or, near the solution where ``F`` is flat to rounding, the residual does."""
+    objective = values - np.einsum("ij,ij->i", target, x)
+    slope = np.einsum("ij,ij->i", residual, step)
+    size = np.linalg.norm(residual, axis=1)
+    scale = np.ones(len(x))
+    for _ in range(_MAX_HALVINGS):
+        trial = x + scale[:, None] * step
+        new, gradients, _ = evaluate(trial)
+        new = new - np.einsum("ij,ij->i", target, trial)
+        closer = np.linalg.norm(gradients - target, axis=1) < size
+        short = (new > objective + _ARMIJO * scale * slope) & ~closer
+        if not np.any(short):
+            break
+        scale[short] *= 0.5
+    return scale[:, None] * step

@@ -20,9 +20,10 @@ scaled to unit median radius first, so ``λ`` is dimensionless. The ellipsoid be
 the semidefinite constraint ``y^T ∇²H(x) y = z^T Q z``, ``z = (x_i y_j)``, ``Q ⪰ ε I``.
 
 Two departures from Zhou's program. (1) The twist term uses ``∇H / d`` (Zhou's quartic uses
-``∇H``, four times the weight of his ellipsoid's ``A x``): the twist term alone is smallest for
-``H → 0``, so a heavy twist weight inflates the surface (Zhou's published quartics give median
-``H`` of 0.4–0.9 on their own training loads) — keep ``w`` near 1. (2) A residual ``|H(x_i) - 1|``
+``∇H``, four times the weight of his ellipsoid's ``A x``). The twist term alone is smallest for
+``H → 0``: with noisy twists it shrinks ``H`` on the data (inflates the surface), the more the
+heavier its weight (Zhou's published quartics have median ``H`` of 0.4–0.9 on their own
+training loads); keep ``w`` near 1. (2) A residual ``|H(x_i) - 1|``
 weighs its pair by ``|x_i|^d`` (its gradient in the coefficients), which biases the surface
 outward by about ``d σ²`` under radial noise ``σ`` (1 % for the quartic at 5 % noise); the program
 is solved once more with the level residuals divided by ``H(x_i)`` of the first fit and the twist
