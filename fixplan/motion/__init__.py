@@ -6,6 +6,16 @@ imports only from :mod:`fixplan.planner`, :mod:`fixplan.models`, :mod:`fixplan.s
 top-level modules.
 """
 
+from fixplan.motion.fitted_quartic import FittedQuartic
+from fixplan.motion.identify import (
+    Fit,
+    FitErrors,
+    FitReport,
+    assess,
+    ellipsoid_from_matrix,
+    fit,
+    synthetic,
+)
 from fixplan.motion.line_contact import line_push_step
 from fixplan.motion.outline import FacePoints, Outline
 from fixplan.motion.pivoting import Settling, settle
@@ -17,6 +27,10 @@ from fixplan.motion.trajectory import Trajectory, push
 
 __all__ = [
     "FacePoints",
+    "Fit",
+    "FitErrors",
+    "FitReport",
+    "FittedQuartic",
     "LinePusher",
     "MotionCone",
     "Outline",
@@ -27,6 +41,9 @@ __all__ = [
     "Sliding",
     "SlipEstimator",
     "Trajectory",
+    "assess",
+    "ellipsoid_from_matrix",
+    "fit",
     "line_push_step",
     "motion_cone",
     "push",
@@ -34,4 +51,5 @@ __all__ = [
     "settle",
     "slide",
     "start_acceleration",
+    "synthetic",
 ]
