@@ -77,6 +77,7 @@ class _Names(Sequence):
 
 _MODEL_NAMES = _Names("fixplan.planner.problem", "MODEL_NAMES")
 _DISK_PROFILES = _Names("fixplan.surface.pressure", "DISK_PROFILES")
+_FIT_MODELS = _Names("fixplan.motion.identify", "MODELS")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -174,6 +175,37 @@ def _build_parser() -> argparse.ArgumentParser:
     push.add_argument("--report", type=Path, metavar="DIR", help="write a report folder")
     _verbosity(push)
     push.set_defaults(run=_run_push)
+
+    fit = _subcommand(
+        commands, "fit", "fit a limit surface to measured loads (and twists) in a CSV file",
+        "fixplan fit measurements.csv --model quartic --report out/",
+    )  # fmt: skip
+    fit.add_argument(
+        "file", type=Path, help="CSV file: columns fx, fy, m [N, N, N m], optionally vx, vy, w "
+        "[m/s, m/s, rad/s] and normal_force [N]",
+    )  # fmt: skip
+    fit.add_argument(
+        "--model", default="ellipsoid", choices=_FIT_MODELS, metavar="MODEL",
+        help="%(choices)s (default %(default)s)",
+    )  # fmt: skip
+    fit.add_argument(
+        "--weight", type=float, metavar="W",
+        help="weight of the twists against the loads, >= 0 (default 1)",
+    )  # fmt: skip
+    fit.add_argument(
+        "--holdout", type=float, metavar="F",
+        help="fraction of the rows held out of the fit to measure it, in [0, 1) (default 0.2)",
+    )  # fmt: skip
+    fit.add_argument(
+        "--normal-force", type=float, metavar="N",
+        help="normal force of the measurements [N] when the file has no normal_force column "
+        "(default 1)",
+    )  # fmt: skip
+    fit.add_argument("--save", type=Path, metavar="FIT.json", help="write the fit as JSON")
+    fit.add_argument("--report", type=Path, metavar="DIR", help="write a report folder")
+    fit.add_argument("--json", action="store_true", help="print one JSON document")
+    _verbosity(fit)
+    fit.set_defaults(run=_run_fit)
     return parser
 
 
@@ -373,6 +405,73 @@ def _run_push(args: argparse.Namespace) -> tuple[int, str]:
         summary["problem"] = {"file": str(push_file.path), "sha256": push_file.sha256}
         return EXIT_OK, _json(summary)
     return EXIT_OK, "\n".join(describe_push(summary))
+
+
+# -- fit -----------------------------------------------------------------------------------------
+
+
+def _fit_options(args: argparse.Namespace) -> dict:
+    """The keyword arguments of :func:`fixplan.motion.fit` given on the command line."""
+    from fixplan.tolerances import MAX_FORCE
+
+    options = {"model": args.model}
+    if args.weight is not None:
+        if not (math.isfinite(args.weight) and args.weight >= 0.0):
+            raise InvalidArgumentError(f"--weight must be a number >= 0, got {args.weight:g}")
+        options["weight"] = args.weight
+    if args.holdout is not None:
+        if not 0.0 <= args.holdout < 1.0:
+            raise InvalidArgumentError(
+                f"--holdout must be a fraction in [0, 1), got {args.holdout:g}"
+            )
+        options["holdout"] = args.holdout
+    if args.normal_force is not None and not 0.0 < args.normal_force <= MAX_FORCE:
+        raise InvalidArgumentError(
+            f"--normal-force must be a number > 0 and at most {MAX_FORCE:g} N, got "
+            f"{args.normal_force:g}"
+        )
+    return options
+
+
+def _run_fit(args: argparse.Namespace) -> tuple[int, str]:
+    from fixplan.io.fit_data import read_fit_data
+    from fixplan.io.fit_report import describe_fit, fit_summary, write_fit_report
+    from fixplan.io.toml_schema import Issue, ProblemFileError
+    from fixplan.motion import fit
+
+    options = _fit_options(args)
+    data = read_fit_data(args.file)
+    if data.normal_forces is not None and args.normal_force is not None:
+        raise InvalidArgumentError(
+            f"--normal-force: {args.file} has a normal_force column already; drop one of them"
+        )
+    if data.twists is None and args.weight is not None:
+        log.warning("--weight is ignored: %s has no twist columns (vx, vy, w)", args.file)
+    normal_force = data.normal_force if data.normal_force is not None else args.normal_force
+    if args.report is not None:
+        _check_output_folder(args.report, "--report")
+    if args.save is not None:
+        _check_output_file(args.save, "--save")
+    log.info("fitting a %s to %d measurements of %s", args.model, data.rows, args.file)
+    try:
+        result = fit(data.fit_loads, data.twists, normal_force=normal_force or 1.0, **options)
+    except InvalidArgumentError as exc:
+        # The data cannot be fitted (too few rows for the model, loads in a plane): name the file.
+        raise ProblemFileError(args.file, [Issue(key_path="", message=str(exc))]) from exc
+    if args.save is not None:
+        try:
+            result.save(args.save)
+        except OSError as exc:
+            raise InvalidArgumentError(f"--save {args.save}: cannot write it: {exc}") from exc
+        log.info("wrote %s", args.save)
+    if args.report is not None:
+        written = write_fit_report(args.report, data, result)
+        log.info("wrote %d report files to %s", len(written), args.report)
+    summary = fit_summary(data, result)
+    summary["data"]["file"] = str(args.file)
+    if args.json:
+        return EXIT_OK, _json(summary)
+    return EXIT_OK, "\n".join(describe_fit(summary))
 
 
 # -- check ---------------------------------------------------------------------------------------
