@@ -28,6 +28,7 @@ from fixplan.models import (
     FrictionModel,
     PointCone,
     PointPyramid,
+    Polytope,
     Pyramid,
 )
 from fixplan.models.compare import compare
@@ -60,6 +61,8 @@ FACTORIES = {
         ls, facets=8, inscribed=False
     ),
     "exact": lambda ls: Exact.from_limit_surface(ls, order=4),
+    "polytope-64-inscribed": lambda ls: Polytope.from_limit_surface(ls, cuts=64),
+    "polytope-64-outside": lambda ls: Polytope.from_limit_surface(ls, cuts=64, inscribed=False),
 }
 
 POINT_MODELS = ("point-cone", "point-pyramid-4-inscribed", "point-pyramid-8-circumscribed")

@@ -28,9 +28,12 @@ SI throughout. The schema::
     mu = 0.25                             # >= 0 (0: frictionless); required unless
                                           # [defaults] gives it
     model = "exact"                       # exact | ellipsoid | cone | pyramid | point-cone
-                                          # | point-pyramid; required unless [defaults] gives it
+                                          # | point-pyramid | fitted; required unless
+                                          # [defaults] gives it ("fitted": not in [defaults])
     facets = 8                            # pyramid models only, >= 3
     inscribed = true                      # pyramid models only
+    fit = "fits/jaw.json"                 # model "fitted" only, required with it
+    cuts = 256                            # model "fitted" with a quartic fit only
     axis = [0.0, 1.0, 0.0]                # optional world direction of the patch x axis
     patch = { shape = "rectangle", length = 0.08, width = 0.03 }
     force = 150.0                         # fixed normal force of a clamp or finger [N]
@@ -41,6 +44,18 @@ SI throughout. The schema::
     force = [120.0, -40.0, -60.0]         # [N], required
     point = [0.03, 0.0, 0.04]             # [m], required
     torque = [0.0, 0.0, 1.5]              # [N m], optional
+
+A **fitted** contact (``model = "fitted"``) takes its friction set from a fit saved by
+:meth:`fixplan.motion.Fit.save` (``fixplan fit ... --json``), the file named by ``fit``, relative
+to the problem file's folder. A fitted ellipsoid enters the planner as its
+:class:`~fixplan.models.FittedEllipsoid`; a quartic as its inscribed polytope of ``cuts``
+tangent planes (even, default :data:`~fixplan.models.polytope.DEFAULT_CUTS` = 256; one linear
+inequality per cut, contact and load case), which lies inside the fitted surface and
+underestimates it by at most its reported ``error`` (about 2 % at 256 cuts). The contact's
+``mu`` is the fit's: leave ``mu`` out (``[defaults]``' ``mu`` does not apply), or give the same
+value. It takes no ``patch`` (the fit is its friction set; the normal force acts at
+``position``). A model override (``--model``) replaces the fitted model too, keeping the fit's
+``mu``.
 
 Patch shapes (lengths [m], coordinates in the contact's patch frame):
 
@@ -69,6 +84,7 @@ from fixplan.errors import InvalidArgumentError
 from fixplan.io.patch_schema import read_patch
 from fixplan.io.toml_schema import (
     MAX_FILE_BYTES,
+    SHORT,
     Array,
     Boolean,
     Choice,
@@ -88,6 +104,7 @@ from fixplan.io.toml_schema import (
     parse_toml,
     read_regular_file,
 )
+from fixplan.motion import Fit, FittedQuartic
 from fixplan.planner.contact_models import PLANNER_EXACT_ORDER, contact_model
 from fixplan.planner.problem import (
     AREA_MODEL_NAMES,
@@ -114,6 +131,8 @@ from fixplan.tolerances import (
 )
 
 KINDS = ("fixture", "grasp")
+#: The model of a contact whose friction set is a saved fit (its ``fit`` key names the file).
+FITTED = "fitted"
 PYRAMID_MODEL_NAMES = ("pyramid", "point-pyramid")
 #: The point model a model override gives to contacts without a patch.
 POINT_VERSION = {
@@ -122,6 +141,13 @@ POINT_VERSION = {
     "cone": "point-cone",
     "pyramid": "point-pyramid",
 }
+
+#: Most tangent planes of a fitted quartic's polytope (each is one inequality per load case;
+#: 4096 cuts approximate a quartic to about 0.1 %).
+MAX_CUTS = 4096
+#: A contact's ``mu`` agrees with its fit's when they differ by at most this fraction (a fit's
+#: ``mu`` typed from a printout with 7 significant digits).
+FIT_MU_RTOL = 1e-6
 
 #: A contact normal in a file must have length 1 within this absolute tolerance (a guard against
 #: typos; the value is normalised exactly when the contact is built).
@@ -152,6 +178,8 @@ _CONTACT_KEYS = (
     "model",
     "facets",
     "inscribed",
+    "fit",
+    "cuts",
     "axis",
     "patch",
     "force",
@@ -274,6 +302,8 @@ _NAME = Text(name=True)
 _BOOLEAN = Boolean()
 _FACETS = Integer(3, MAX_FACETS)
 _MODEL = Choice(MODEL_NAMES)
+_CONTACT_MODEL = Choice((*MODEL_NAMES, FITTED))
+_CUTS = Integer(6, MAX_CUTS)
 _POSITION = Array((3,), Number("", MAX_LENGTH, "m"))
 _FORCE_VECTOR = Array((3,), Number("", MAX_FORCE, "N"))
 _TORQUE_VECTOR = Array((3,), Number("", MAX_TORQUE, "N m"))
@@ -295,6 +325,7 @@ class _Reader:
         self.folder = folder
         self.model = model
         self.issues: list[Issue] = []
+        self.fits: dict[tuple[str, int | None], object] = {}  # planner models of fits read
 
     def document(self, data: dict) -> tuple[str | None, str | None, Problem | None]:
         """The file's name, kind and problem (``None`` where invalid)."""
@@ -372,13 +403,28 @@ class _Reader:
         role = table.get("role", Choice(ROLES), required=True)
         position = table.get("position", _POSITION, required=True)
         normal = _normal(table)
-        mu = _with_default(table, "mu", _MU, defaults, required=True)
-        file_model = _with_default(table, "model", _MODEL, defaults, required=self.model is None)
+        file_model = _with_default(
+            table, "model", _CONTACT_MODEL, defaults, required=self.model is None
+        )
+        fitted = self._fit(table) if file_model == FITTED else None
+        if file_model == FITTED:
+            mu = None if fitted is None else _fitted_mu(table, fitted.mu)
+        else:
+            mu = _with_default(table, "mu", _MU, defaults, required=True)
+            for key in ("fit", "cuts"):
+                if key in table.data:
+                    table.report(key, f"only for model {FITTED!r}; remove it or change the model")
         model = self.model or file_model
         if self.model in AREA_MODEL_NAMES and "patch" not in table.data:
             model = POINT_VERSION[self.model]  # an override keeps point contacts point contacts
         facets = self._pyramid_option(table, "facets", _FACETS, defaults, model)
         inscribed = self._pyramid_option(table, "inscribed", _BOOLEAN, defaults, model)
+        if file_model == FITTED and self.model is None and "patch" in table.data:
+            table.report(
+                "patch",
+                f"not for model {FITTED!r}: its fit is the contact's friction set; remove the "
+                "patch (the normal force acts at position)",
+            )
         patch, patch_axis = read_patch(table, folder=self.folder)
         if model == "exact" and patch is not None:
             _check_exact_size(table, patch)
@@ -386,6 +432,8 @@ class _Reader:
             self._report_missing_patch(table, model, name)
         axis = _contact_axis(table, patch_axis)
         force, max_force = (_active_force(table, key, role) for key in ("force", "max_force"))
+        if model == FITTED:
+            model = fitted
         required = (name, role, position, normal, mu, model)
         if len(self.issues) > start or None in required:
             return None
@@ -405,6 +453,35 @@ class _Reader:
             force=force,
             max_force=max_force,
         )
+
+    def _fit(self, table: Table):
+        """The planner model of the contact's saved fit (``fit``, ``cuts``), or ``None`` with
+        the issue reported."""
+        name = table.get("fit", _TEXT, required=True)
+        cuts = table.get("cuts", _CUTS)
+        if name is None or ("cuts" in table.data and cuts is None):
+            return None
+        if cuts is not None and cuts % 2:
+            table.report(
+                "cuts", f"expected an even integer (planes come in mirror pairs), got {cuts}"
+            )
+            return None
+        if (name, cuts) in self.fits:
+            return self.fits[name, cuts]
+        try:
+            read_regular_file(self.folder / name, MAX_FILE_BYTES)
+            fit = Fit.load(self.folder / name)
+        except (InvalidValueError, InvalidArgumentError) as exc:
+            table.report("fit", f"cannot read the fit file {SHORT.repr(name)}: {exc}")
+            return None
+        if cuts is not None and not isinstance(fit.surface, FittedQuartic):
+            table.report(
+                "cuts",
+                f"only for a quartic fit; {SHORT.repr(name)} is an ellipsoid, which enters the "
+                "planner exactly: remove cuts",
+            )
+            return None
+        return self.fits.setdefault((name, cuts), fit.planner_model(cuts=cuts))
 
     def _pyramid_option(
         self, table: Table, key: str, kind: Kind, defaults: _Defaults, model: str | None
@@ -446,6 +523,21 @@ def _check_exact_size(table: Table, patch: pressure.PressureField) -> None:
             f"the {MAX_EXACT_POINTS} accepted; give fewer vertices, points or grid cells, or "
             "use another model",
         )
+
+
+def _fitted_mu(table: Table, fit_mu: float) -> float | None:
+    """The fit's ``mu``; reports a contact ``mu`` that contradicts it."""
+    if "mu" not in table.data:
+        return fit_mu
+    mu = table.get("mu", _MU)
+    if mu is not None and abs(mu - fit_mu) > FIT_MU_RTOL * fit_mu:
+        table.report(
+            "mu",
+            f"{mu:g} contradicts the fit's mu {fit_mu:.7g}: a fitted contact takes mu from its "
+            "fit; remove mu, or refit",
+        )
+        return None
+    return fit_mu
 
 
 def _with_default(table: Table, key: str, kind: Kind, defaults: _Defaults, *, required: bool):

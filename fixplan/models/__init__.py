@@ -19,7 +19,12 @@ model                         torsion     motion  conservative  cvxpy form
 :class:`PointCone`            no          yes     yes           one second-order cone
 :class:`PointPyramid`         no          no      if inscribed  ``k`` linear inequalities
 :class:`Exact`                yes         yes     no (±quad.)   one small cone per point
+:class:`Polytope`             yes         yes     if inscribed  ``2k`` linear inequalities
 ============================  ==========  ======  ============  ===========================
+
+A :class:`Polytope` is any set of linear inequalities; built from tangent planes it reports its
+largest radial gap to the surface cut (``from_limit_surface``; a fitted quartic's
+``planner_model``).
 
 Every model accepts ``mu = 0``, a frictionless contact: its set is the load 0 and its
 constraints ``load == 0`` (see :mod:`fixplan.models.base`). Accuracy against the exact surface is
@@ -31,6 +36,7 @@ from fixplan.models.conic import ConicForm
 from fixplan.models.ellipsoid import Ellipsoid, FacetedEllipsoid, FittedEllipsoid, fit_ellipsoid
 from fixplan.models.exact import Exact
 from fixplan.models.polyhedral import Cone, PointCone, PointPyramid, Pyramid
+from fixplan.models.polytope import Polytope
 
 #: Every model class, in the order of the table above.
 MODEL_CLASSES = (
@@ -42,6 +48,7 @@ MODEL_CLASSES = (
     PointCone,
     PointPyramid,
     Exact,
+    Polytope,
 )
 
 __all__ = [
@@ -55,6 +62,7 @@ __all__ = [
     "FrictionModel",
     "PointCone",
     "PointPyramid",
+    "Polytope",
     "Pyramid",
     "fit_ellipsoid",
 ]

@@ -6,16 +6,9 @@ imports only from :mod:`fixplan.planner`, :mod:`fixplan.models`, :mod:`fixplan.s
 top-level modules.
 """
 
+from fixplan.motion.fit_report import Fit, FitErrors, FitReport, assess
 from fixplan.motion.fitted_quartic import FittedQuartic
-from fixplan.motion.identify import (
-    Fit,
-    FitErrors,
-    FitReport,
-    assess,
-    ellipsoid_from_matrix,
-    fit,
-    synthetic,
-)
+from fixplan.motion.identify import ellipsoid_from_matrix, fit, synthetic
 from fixplan.motion.line_contact import line_push_step
 from fixplan.motion.outline import FacePoints, Outline
 from fixplan.motion.pivoting import Settling, settle
