@@ -351,7 +351,7 @@ def test_data_the_fit_cannot_use_names_the_file(tmp_path, capsys):
     path = write_csv(tmp_path / "few.csv", loads[:18], twists[:18])
     code, _, err = run(capsys, path, "--model", "quartic")
     assert code == EXIT_INVALID_INPUT
-    assert err.startswith(f"fixplan: error: {path}: a quartic fit needs at least 15 fitted pairs")
+    assert err.startswith(f"fixplan: error: {path}: the quartic fit needs at least 15 fitted pairs")
     flat = np.column_stack([loads[:, :2], np.zeros(150)])
     code, _, err = run(capsys, write_csv(tmp_path / "flat.csv", flat))
     assert code == EXIT_INVALID_INPUT and "every moment is zero" in err

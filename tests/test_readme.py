@@ -5,6 +5,8 @@ import math
 import re
 from pathlib import Path
 
+import pytest
+
 from fixplan.io.cli import EXIT_INVALID_INPUT, EXIT_OK, main
 from fixplan.io.problem_file import load_problem
 
@@ -75,3 +77,14 @@ def test_the_pushing_example_gives_the_numbers_its_comments_state():
     )
     assert names["step"].mode == "sliding-right"
     assert round(names["squared"].line_contact_travel(), 4) == 0.0598
+
+
+def test_the_identification_example_recovers_the_friction_it_was_made_with(tmp_path, monkeypatch):
+    (code,) = _blocks(_section("Limit surfaces from measurements (`fixplan.motion.fit`, `SlipEstimator`)"),
+                      "python")  # fmt: skip
+    monkeypatch.chdir(tmp_path)
+    names: dict = {}
+    exec(code, names)
+    assert names["quartic"].surface.mu == pytest.approx(0.4, rel=0.03)
+    assert names["estimator"].mu == pytest.approx(0.4, rel=0.03)
+    assert (tmp_path / "rectangle-fit.json").is_file()

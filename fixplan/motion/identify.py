@@ -138,7 +138,7 @@ def fit(
     train, test = order[held:], order[:held]
     if len(train) < _COEFFICIENTS[model]:
         raise InvalidArgumentError(
-            f"a {model} fit needs at least {_COEFFICIENTS[model]} fitted pairs (its coefficients)"
+            f"the {model} fit needs at least {_COEFFICIENTS[model]} fitted pairs (its coefficients)"
             f", got {len(train)} of {len(loads)} after holding out {held}"
         )
     x = loads[train] * np.array([1.0, 1.0, 1.0 / rho])
