@@ -386,3 +386,20 @@ def test_given_forces_too_weak_for_the_weight_are_explained_as_such():
     assert plan.status == "infeasible"
     assert "not even without it (with the given active forces and the weight)" in plan.certificate
     assert abs(plan.infeasible_motions["off-axis"].direction @ [0, 0, 1]) == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("scale", [0.1, 10.0])
+def test_a_model_object_plans_and_verifies_the_same_whatever_normal_force_it_was_built_at(scale):
+    # The planner scales a contact's model by the contact's own normal force: the normal force a
+    # model object was built at must change neither the plan nor its verification.
+    unit = Ellipsoid.from_limit_surface(LimitSurface(pressure.disk(RADIUS), mu=MU))
+    other = Ellipsoid.from_limit_surface(LimitSurface(pressure.disk(RADIUS), mu=MU,
+                                                      normal_force=scale))  # fmt: skip
+    load = off_axis_load(offset=0.03)
+    patch = pressure.disk(RADIUS)
+    reference, plan = (solve(pinch(model, load=load, patch=patch)) for model in (unit, other))
+    assert plan.objective_value == pytest.approx(reference.objective_value, rel=1e-7)
+    assert plan.safety_factor == pytest.approx(1.0, rel=1e-6)
+    # Both contacts on their limit: the utilisation is 1, not 1 / scale.
+    np.testing.assert_allclose(plan.utilisation, reference.utilisation, rtol=1e-6)
+    np.testing.assert_allclose(plan.utilisation, 1.0, rtol=1e-6)

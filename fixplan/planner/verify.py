@@ -84,7 +84,8 @@ def friction_use(
     pressed = carries & (normal_force > noise)
     use[carries & ~pressed] = np.inf
     if np.any(pressed):
-        safety = np.atleast_1d(model.safety_factor(load[pressed] / normal_force[pressed, None]))
+        per_unit = load[pressed] / normal_force[pressed, None]  # the model at unit normal force
+        safety = np.atleast_1d(model.safety_factor(per_unit, normal_force=1.0))
         with np.errstate(divide="ignore"):
             use[pressed] = 1.0 / safety
     return use
