@@ -26,20 +26,14 @@ Run: ``python examples/pushing_real_data.py [--data DIR] [--group abs/rect1 ...]
 from __future__ import annotations
 
 import argparse
-import csv
-import json
-import math
 from pathlib import Path
 
 import numpy as np
+from mcube import DEFAULT_DATA, measured_pushes, pose, pose_error, replay, shape, zhou_fits
 
 from fixplan import LimitSurface, pressure
 from fixplan.models import FittedEllipsoid
-from fixplan.motion import Outline, PointPusher, push
-
-HOLDOUT_SURFACE = "plywood"
-PUSHER_RADIUS = 0.00475  # m, the steel cylinder of the MIT push dataset
-DEFAULT_DATA = Path(__file__).resolve().parents[2] / "shared" / "real_data"
+from fixplan.motion import Outline
 
 #: Largest mean difference from Zhou's simulated final poses that counts as reproducing them
 #: (the same model and pusher friction; what remains is integration and contact handling).
@@ -52,52 +46,38 @@ NO_FIT_RECORDED = {"abs/rect1": (2.39, 2.87)}
 NO_FIT_SLACK_MM, NO_FIT_SLACK_DEG = 0.05, 0.05
 
 
-def angle_difference(a: float, b: float) -> float:
-    """|a - b| modulo 2π [rad]."""
-    return abs((a - b + math.pi) % (2 * math.pi) - math.pi)
-
-
 def simulate_group(
     data: Path, group: str, steps: int, no_fit: bool = False, limit: int | None = None
 ) -> dict:
     """Mean errors [mm, deg] of fixplan's simulation of one group's test pushes (and of the
     exact limit surface of uniform pressure when ``no_fit``)."""
-    surface_name, shape_name = group.split("/")
-    shapes = json.loads((data / "mcube_shapes.json").read_text())["shapes"]
     # The plywood half is held out (``holdout/``): only for the final validation, as nothing here
     # is fitted or tuned (Zhou's fits are his; the no-fit surface has no parameter).
-    split = data / "holdout" if surface_name == HOLDOUT_SURFACE else data
-    fit = json.loads((split / "mcube_zhou_fits.json").read_text())["fits"][group]["quadratic"]
-    shape = shapes[shape_name]
+    fit = zhou_fits(data, group)["quadratic"]
+    part = shape(data, group)
     # Zhou's H(x) = xᵀ A x with x = (fx, fy, m / rho): q of a model with mu = 1 and that rho.
-    model = FittedEllipsoid(matrix=np.array(fit["A_normalised"]), mu=1.0, rho=shape["rho_m"])
-    outline = Outline.polygon(shape["vertices_m"])
-    uniform = LimitSurface(pressure.polygon(shape["vertices_m"], centered=False), mu=1.0)
-    with (split / "mcube_test_pushes.csv").open(newline="") as handle:
-        rows = [r for r in csv.DictReader(handle) if (r["surface"], r["shape"]) == (surface_name,
-                                                                                   shape_name)]  # fmt: skip
+    model = FittedEllipsoid(matrix=np.array(fit["A_normalised"]), mu=1.0, rho=part["rho_m"])
+    outline = Outline.polygon(part["vertices_m"])
+    uniform = LimitSurface(pressure.polygon(part["vertices_m"], centered=False), mu=1.0)
+    rows = measured_pushes(data, group, limit)
     errors = {"zhou_mm": [], "zhou_deg": [], "ours_mm": [], "ours_deg": [], "sim_mm": [],
               "sim_deg": [], "moved_mm": [], "turned_deg": [], "exact_mm": [],
               "exact_deg": []}  # fmt: skip
-    for row in rows[:limit]:
-        x = {k: float(v) for k, v in row.items() if k not in ("surface", "shape")}
-        start = np.array([x["tipx0_m"], x["tipy0_m"]])
-        velocity = np.array([x["tipx1_m"], x["tipy1_m"]]) - start  # over 1 s
-        pusher = PointPusher((start, velocity), mu=fit["mu_pusher_best"], radius=PUSHER_RADIUS)
-        pose = (x["x0_m"], x["y0_m"], x["th0_rad"])
-        final = push(model, pusher, shape=outline, pose=pose, duration=1.0, steps=steps).poses[-1]
-        measured = np.array([x["x1_m"], x["y1_m"], x["th1_rad"]])
-        zhou = np.array([x["quad_x1_m"], x["quad_y1_m"], x["quad_th1_rad"]])
+    for row in rows:
+        final = replay(model, row, outline, mu=fit["mu_pusher_best"], steps=steps)
+        measured, zhou = pose(row), pose(row, simulator="quad_")
         pairs = [("zhou", final, zhou), ("ours", final, measured), ("sim", zhou, measured)]
         if no_fit:
-            exact = push(uniform, pusher, shape=outline, pose=pose, duration=1.0, steps=steps)
-            pairs.append(("exact", exact.poses[-1], measured))
+            exact = replay(uniform, row, outline, mu=fit["mu_pusher_best"], steps=steps)
+            pairs.append(("exact", exact, measured))
         for key, a, b in pairs:
-            errors[f"{key}_mm"].append(1000 * np.linalg.norm(a[:2] - b[:2]))
-            errors[f"{key}_deg"].append(math.degrees(angle_difference(a[2], b[2])))
-        errors["moved_mm"].append(1000 * math.hypot(x["x1_m"] - x["x0_m"], x["y1_m"] - x["y0_m"]))
-        errors["turned_deg"].append(math.degrees(angle_difference(x["th1_rad"], x["th0_rad"])))
-    return {"pushes": len(rows[:limit]), **{k: float(np.mean(v)) for k, v in errors.items() if v}}
+            millimetres, degrees = pose_error(a, b)
+            errors[f"{key}_mm"].append(millimetres)
+            errors[f"{key}_deg"].append(degrees)
+        moved, turned = pose_error(pose(row, at="0"), measured)
+        errors["moved_mm"].append(moved)
+        errors["turned_deg"].append(turned)
+    return {"pushes": len(rows), **{k: float(np.mean(v)) for k, v in errors.items() if v}}
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -10,7 +10,8 @@ import pytest
 from fixplan import LimitSurface, pressure
 from fixplan.errors import InvalidArgumentError
 from fixplan.models import Ellipsoid, Exact, FittedEllipsoid
-from fixplan.motion import motion_cone, push_step
+from fixplan.motion import FittedQuartic, motion_cone, push_step
+from fixplan.motion.fitted_quartic import monomials
 
 MU, NORMAL_FORCE, RADIUS = 0.5, 10.0, 0.05
 DISK = LimitSurface(pressure.disk(RADIUS), mu=MU, normal_force=NORMAL_FORCE)
@@ -337,3 +338,61 @@ def test_bad_arguments_of_a_step_raise_an_error_naming_them(argument, value, wor
             push_step(surface, **arguments, mu=0.3)
         for word in words:
             assert word in str(caught.value)
+
+
+# -- a quartic's two routes -----------------------------------------------------------------------
+
+
+def skewed_quartic():
+    """A strictly SOS-convex quartic in ``x = (fx, fy, m / rho)``: ``|S x|^4 + 0.3 (x^4 + y^4 +
+    z^4)`` (sums and linear maps of SOS-convex forms are SOS-convex), least squares on points."""
+    stretch = np.array([[1.0, 0.3, -0.2], [0.0, 0.8, 0.4], [0.1, 0.0, 1.5]])
+    points = np.random.default_rng(5).standard_normal((60, 3))
+    values = np.sum((points @ stretch.T) ** 2, axis=1) ** 2 + 0.3 * np.sum(points**4, axis=1)
+    coefficients = np.linalg.lstsq(monomials(points), values, rcond=None)[0]
+    return FittedQuartic(coefficients=coefficients, rho=0.05, normal_force=2.0)
+
+
+class ForwardRoute:
+    """A quartic seen without its ``closed_form_motion`` flag: pushed through its forward map."""
+
+    def __init__(self, quartic):
+        self.quartic = quartic
+        self.normal_force = quartic.normal_force
+        self.motion = quartic.motion
+        self.safety_factor = quartic.safety_factor
+        self.motion_and_safety_factor = quartic.motion_and_safety_factor
+        self.load = quartic.load
+
+
+#: Agreement of the two routes' steps (both solve to rounding; what differs is the root found).
+ROUTES_RTOL = 1e-9
+
+
+def test_a_quartic_step_through_its_inverse_map_is_the_step_through_its_forward_map(monkeypatch):
+    quartic = skewed_quartic()
+    rng = np.random.default_rng(11)
+    cases = []
+    for _ in range(30):
+        normal = rng.normal(size=2)
+        cases.append({"contact": rng.uniform(-0.06, 0.06, 2), "normal": normal,
+                      "velocity": normal + 0.5 * rng.normal(size=2), "mu": rng.uniform(0.1, 1.0)})  # fmt: skip
+    references = [push_step(ForwardRoute(quartic), **case) for case in cases]
+
+    def no_forward_map(self, twist):
+        raise AssertionError("the quartic's step went through its forward map")
+
+    monkeypatch.setattr(FittedQuartic, "load", no_forward_map)
+    modes = set()
+    for case, reference in zip(cases, references, strict=True):
+        step = push_step(quartic, **case)
+        assert step.mode == reference.mode
+        modes.add(step.mode)
+        if step.mode == "separated":
+            continue
+        twist_size = np.linalg.norm(reference.twist * [1.0, 1.0, quartic.rho])
+        np.testing.assert_allclose(step.twist, reference.twist, rtol=0.0,
+                                   atol=ROUTES_RTOL * twist_size)  # fmt: skip
+        np.testing.assert_allclose(step.load, reference.load, rtol=0.0,
+                                   atol=ROUTES_RTOL * np.linalg.norm(reference.load))  # fmt: skip
+    assert {"sticking", "sliding-left", "sliding-right"} <= modes

@@ -22,6 +22,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 
@@ -158,6 +159,10 @@ class FittedQuartic:
     normal_force : float
         Normal force [N] at which the surface holds (at which the loads were measured).
     """
+
+    #: The inverse map (:meth:`motion`) is closed form and the forward map (:meth:`load`) a
+    #: Newton solve: :func:`fixplan.motion.push_step` takes the route through the motion cone.
+    closed_form_motion: ClassVar[bool] = True
 
     coefficients: np.ndarray
     rho: float

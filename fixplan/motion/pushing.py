@@ -22,9 +22,11 @@ counter-clockwise).
   (``N = (c_y, -c_x, 1)``, rotation about the contact point), along which ``h`` is convex: for a
   surface with a forward map (``load(twist) = ∇h``) the minimum is one root of
   ``∇h(V_0 + s N) · N`` (at a facet, a kink of ``h``, the load is the subgradient of the
-  one-sided loads that annuls it). Surfaces with only the inverse map are solved on the force
-  angle instead: as the force turns across the friction cone the contact velocity ``J V(F)``
-  turns the same way (``J ∇²H J^T`` is positive definite). An ellipsoid ``H(L) = L^T A L`` has
+  one-sided loads that annuls it). Surfaces with only the inverse map, or with a closed-form
+  inverse map and an iterative forward map (a class attribute ``closed_form_motion = True``, as
+  :class:`~fixplan.motion.fitted_quartic.FittedQuartic`), are solved on the force angle
+  instead: as the force turns across the friction cone the contact velocity ``J V(F)`` turns
+  the same way (``J ∇²H J^T`` is positive definite). An ellipsoid ``H(L) = L^T A L`` has
   the closed form ``F ∝ (J A J^T)^{-1} v_p``. The sticking force found, in the friction cone the
   pusher sticks; outside it, it slides on that side.
 - **Sliding**: when ``v_p`` lies outside the *motion cone* (the contact velocities that the cone's
@@ -142,8 +144,9 @@ def push_step(surface, *, contact, normal, velocity, mu: float) -> PushStep:
     push = _dot(velocity, geometry.normal)
     if push <= 0.0:
         return PushStep.separated(_dot(velocity, geometry.tangent))
-    # Sticking: through the forward map where the surface has one (then the force found tells
-    # the side it slides on if it lies outside the cone), else from the motion cone.
+    # Sticking: through the forward map where the surface has one and its inverse map is not the
+    # cheaper (then the force found tells the side it slides on if it lies outside the cone),
+    # else from the motion cone.
     sticking = geometry.sticking_by_forward_map(velocity)
     if sticking is None:
         side = _side(geometry.normal, *geometry.edge_velocities(), velocity)
@@ -221,6 +224,9 @@ class _Geometry:
         nx, ny = nx / length, ny / length
         mu = validation.nonnegative_scalar("mu", mu)
         ellipsoid = _ellipsoid_matrix(surface)
+        # A closed-form inverse map beside an iterative forward map (a quartic's Newton solve):
+        # the force-angle route costs less than root finding through the forward map.
+        closed_form = getattr(type(surface), "closed_form_motion", False) is True
         return cls(
             surface=surface,
             contact=contact,
@@ -228,7 +234,9 @@ class _Geometry:
             tangent=(-ny, nx),
             half_angle=math.atan(mu),
             ellipsoid=ellipsoid,
-            forward=None if ellipsoid is not None else getattr(surface, "load", None),
+            forward=None
+            if ellipsoid is not None or closed_form
+            else getattr(surface, "load", None),
             joint=getattr(surface, "motion_and_safety_factor", None),
         )
 
