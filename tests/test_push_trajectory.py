@@ -161,3 +161,17 @@ def test_a_point_pusher_trajectory_records_its_pusher_and_single_contacts():
     touching = np.array([mode != "separated" for mode in trajectory.modes])
     np.testing.assert_array_equal(trajectory.contact_counts, touching.astype(int))
     assert trajectory.line_contact_travel() is None
+
+
+def test_outline_distance_is_negative_exactly_inside_a_star_shaped_outline():
+    # Inside or not by the winding number (the angle swept by the vertices seen from the point),
+    # independent of the crossing-number test in the outline.
+    angles = np.linspace(0.0, 2.0 * np.pi, 201)[:-1]
+    radii = 0.05 * (1.0 + 0.4 * np.sin(7 * angles))
+    vertices = np.column_stack([radii * np.cos(angles), radii * np.sin(angles)])
+    star = Outline.polygon(vertices)
+    for point in np.random.default_rng(3).uniform(-0.08, 0.08, (400, 2)):
+        seen = np.arctan2(*(vertices - point)[:, ::-1].T)
+        turns = np.diff(np.append(seen, seen[0]))
+        winding = np.sum((turns + np.pi) % (2 * np.pi) - np.pi) / (2 * np.pi)
+        assert (star.nearest(point)[2] < 0.0) == (abs(round(winding)) == 1)

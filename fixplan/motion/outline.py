@@ -158,10 +158,12 @@ class FacePoints:
 
 
 def _inside(vertices: np.ndarray, point: np.ndarray) -> bool:
-    """Whether ``point`` lies strictly inside the polygon (crossing number)."""
+    """Whether ``point`` lies strictly inside the polygon (crossing number, over all edges at
+    once)."""
     x, y = point
-    inside = False
-    for (x0, y0), (x1, y1) in zip(vertices, np.roll(vertices, -1, axis=0), strict=True):
-        if (y0 > y) != (y1 > y) and x < x0 + (y - y0) * (x1 - x0) / (y1 - y0):
-            inside = not inside
-    return inside
+    x0, y0 = vertices[:, 0], vertices[:, 1]
+    x1, y1 = np.roll(x0, -1), np.roll(y0, -1)
+    straddles = (y0 > y) != (y1 > y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        crossing = x0 + (y - y0) * (x1 - x0) / (y1 - y0)
+    return bool(np.count_nonzero(straddles & (x < crossing)) % 2)
