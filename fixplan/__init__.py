@@ -3,12 +3,14 @@
 The science follows Howe & Cutkosky, "Practical Force-Motion Models for Sliding Manipulation":
 exact limit surfaces of planar contacts for any pressure distribution (:class:`LimitSurface`,
 :mod:`fixplan.pressure`), the paper's approximations with their errors measured
-(:mod:`fixplan.models`, :mod:`fixplan.compare`), and a convex planner built on them
-(:class:`Problem`, :func:`solve`).
+(:mod:`fixplan.models`, :mod:`fixplan.compare`), a convex planner built on them
+(:class:`Problem`, :func:`solve`), and how parts move and how their limit surfaces are learnt
+from measurements (:mod:`fixplan.motion`).
 
 The package is layered; each subpackage imports only from those below it::
 
-    io/        problem files, reports, figures, command line
+    io/        problem, push and measurement files, reports, figures, command line
+    motion/    pushing, pivoting, sliding dynamics, fits and slip-onset updates of limit surfaces
     planner/   problems -> stacked convex problem -> verified plans, motions, certificates
     models/    friction models (ellipsoid family, cones, pyramids, exact) and compare
     surface/   pressure fields -> exact limit surface (support, forward and inverse maps)
@@ -52,6 +54,7 @@ _EXPORTS = {
 _MODULES = {
     "compare": "fixplan.models.compare",
     "models": "fixplan.models",
+    "motion": "fixplan.motion",
     "pressure": "fixplan.surface.pressure",
 }
 
@@ -76,6 +79,7 @@ __all__ = [
     "compare",
     "load_problem",
     "models",
+    "motion",
     "pressure",
     "solve",
 ]
