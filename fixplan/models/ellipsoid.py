@@ -15,9 +15,10 @@ from typing import TYPE_CHECKING, ClassVar
 import numpy as np
 
 from fixplan import validation
-from fixplan.errors import ConvergenceError, InvalidArgumentError
+from fixplan.errors import InvalidArgumentError
 from fixplan.models.base import FrictionModel, finite_pair, fmt
 from fixplan.models.conic import unit_conic
+from fixplan.models.sdp import solve_sdp
 from fixplan.surface.sphere import fibonacci_sphere
 from fixplan.tolerances import FIT_MIN_EIGENVALUE, TILT_ATOL
 
@@ -408,18 +409,8 @@ def fit_ellipsoid(points: np.ndarray) -> tuple[np.ndarray, float]:
     problem = cp.Problem(
         cp.Minimize(cp.sum_squares(residual)), [matrix >> FIT_MIN_EIGENVALUE * np.eye(3)]
     )
-    for solver in (cp.CLARABEL, cp.SCS):
-        try:
-            problem.solve(solver=solver)
-        except cp.error.SolverError:
-            continue
-        if problem.status == cp.OPTIMAL:
-            break
-    else:
-        raise ConvergenceError(
-            f"the ellipsoid fit did not converge (status {problem.status!r} with Clarabel and "
-            "SCS); check that the points surround the origin in all three directions"
-        )
+    solve_sdp(problem, what="the ellipsoid fit",
+              advice="check that the points surround the origin in all three directions")  # fmt: skip
     value = np.asarray(matrix.value)
     value = 0.5 * (value + value.T)
     gap = np.sqrt(np.einsum("ij,jk,ik->i", points, value, points)) - 1.0

@@ -42,8 +42,9 @@ import math
 import numpy as np
 
 from fixplan import validation
-from fixplan.errors import ConvergenceError, InvalidArgumentError
+from fixplan.errors import InvalidArgumentError
 from fixplan.models.ellipsoid import FittedEllipsoid
+from fixplan.models.sdp import solve_sdp
 from fixplan.motion.fit_report import MODELS, Fit, FitReport, assess, measured_pairs
 from fixplan.motion.fitted_quartic import (
     EXPONENTS,
@@ -275,7 +276,10 @@ def _solve_fit(model, x, directions, weight, regularization) -> tuple[np.ndarray
     for _ in range(2):
         problem, variable, level = _program(cp, model, x, directions, weight, regularization,
                                             level_weights, twist_weights)  # fmt: skip
-        solver = _solve(cp, problem, model)
+        solver = solve_sdp(
+            problem, what=f"the {model} fit",
+            advice="check that the loads surround the origin and are not dominated by outliers",
+        )  # fmt: skip
         # H of the fit (> 0: it is strictly convex) sets the weights of the next solve.
         fitted = np.maximum(np.asarray(level.value), MIN_CURVATURE)
         level_weights, twist_weights = 1.0 / fitted, fitted ** (1.0 / degree - 1.0)
@@ -310,21 +314,6 @@ def _program(cp, model, x, directions, weight, regularization, level_weights, tw
         gaps = cp.vstack([normals[k] - cp.multiply(stretch, directions[:, k]) for k in range(3)])
         objective += weight * cp.sum(cp.multiply(twist_weights, cp.norm(gaps, 2, axis=0))) / count
     return cp.Problem(cp.Minimize(objective), constraints), variable, level
-
-
-def _solve(cp, problem, model: str) -> str:
-    """Solve with Clarabel, once more with SCS if Clarabel fails; the solver's name."""
-    for solver in (cp.CLARABEL, cp.SCS):
-        try:
-            problem.solve(solver=solver)
-        except cp.error.SolverError:
-            continue
-        if problem.status == cp.OPTIMAL:
-            return solver
-    raise ConvergenceError(
-        f"the {model} fit did not solve to optimality (status {problem.status!r} with Clarabel "
-        "and SCS); check that the loads surround the origin and are not dominated by outliers"
-    )
 
 
 # -- helpers ----------------------------------------------------------------------------------------
