@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from fixplan import __version__
+from fixplan.io import cli as cli_module
 from fixplan.io.cli import (
     EXIT_INVALID_INPUT,
     EXIT_NOT_HELD,
@@ -405,3 +406,15 @@ def test_a_reader_that_leaves_early_gets_no_traceback(tmp_path):
     os.close(write_end)
     assert result.returncode == EXIT_OK
     assert "Traceback" not in result.stderr
+
+
+def test_every_subcommand_example_names_a_problem_file_that_exists():
+    root = Path(__file__).resolve().parents[1]
+    parser = cli_module._build_parser()
+    commands = next(a for a in parser._actions if a.dest == "command").choices
+    for name, sub in commands.items():
+        example = sub.description.splitlines()[1].split()
+        assert example[:2] == ["fixplan", name]
+        for word in example[2:]:
+            if word.startswith("problems/"):
+                assert (root / word).is_file(), f"{name}: {word}"

@@ -88,13 +88,21 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_INVALID_INPUT, f"{self.prog}: error: {message}\n")
 
 
-def _subcommand(commands, name: str, help_text: str, example: str):
-    return commands.add_parser(
+def _subcommand(commands, name: str, help_text: str, example: str, run):
+    """A subcommand that runs ``run(args)``, with the options every subcommand has: ``--json``
+    and the verbosity."""
+    parser = commands.add_parser(
         name,
         help=help_text,
         description=f"example:\n  {example}\n\n{help_text}\n\n{EXIT_CODES}",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    parser.add_argument("--json", action="store_true", help="print one JSON document")
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument("-q", "--quiet", action="store_true", help="errors only on stderr")
+    group.add_argument("-v", "--verbose", action="store_true", help="more detail on stderr")
+    parser.set_defaults(run=run)
+    return parser
 
 
 def _build_parser() -> argparse.ArgumentParser:
@@ -109,9 +117,9 @@ def _build_parser() -> argparse.ArgumentParser:
     plan = _subcommand(
         commands, "plan", "solve a problem file and summarise the plan",
         "fixplan plan problems/vise-milling.toml --report out/",
+        _run_plan,
     )  # fmt: skip
     plan.add_argument("file", type=Path, help="problem file (TOML)")
-    plan.add_argument("--json", action="store_true", help="print one JSON document")
     plan.add_argument("--report", type=Path, metavar="DIR", help="write a report folder")
     plan.add_argument(
         "--model",
@@ -121,21 +129,18 @@ def _build_parser() -> argparse.ArgumentParser:
         "%(choices)s",
     )
     plan.add_argument("--solver", choices=("CLARABEL", "OSQP", "SCS"), help="conic/QP solver")
-    _verbosity(plan)
-    plan.set_defaults(run=_run_plan)
 
     check = _subcommand(
         commands, "check", "validate a problem file and report every problem in it",
         "fixplan check problems/fixture-321.toml",
+        _run_check,
     )  # fmt: skip
     check.add_argument("file", type=Path, help="problem file (TOML)")
-    check.add_argument("--json", action="store_true", help="print one JSON document")
-    _verbosity(check)
-    check.set_defaults(run=_run_check)
 
     surface = _subcommand(
         commands, "surface", "the limit surface of one contact patch and every model's error",
         "fixplan surface --shape disk --radius 0.01 --pressure hertz --mu 0.8 --normal-force 20",
+        _run_surface,
     )  # fmt: skip
     surface.add_argument("--shape", choices=("disk", "rectangle"), required=True)
     surface.add_argument("--radius", type=float, help="disk radius [m]")
@@ -152,33 +157,27 @@ def _build_parser() -> argparse.ArgumentParser:
     surface.add_argument("--mu", type=float, required=True, help="friction coefficient")
     surface.add_argument("--normal-force", type=float, default=1.0, help="normal force [N]")
     surface.add_argument("--plot", type=Path, metavar="PNG", help="save the cross sections")
-    surface.add_argument("--json", action="store_true", help="print one JSON document")
-    _verbosity(surface)
-    surface.set_defaults(run=_run_surface)
 
     compare = _subcommand(
         commands, "compare", "solve a problem with every applicable model, side by side",
         "fixplan compare problems/hertz-pinch.toml",
+        _run_compare,
     )  # fmt: skip
     compare.add_argument("file", type=Path, help="problem file (TOML)")
-    compare.add_argument("--json", action="store_true", help="print one JSON document")
     compare.add_argument("--solver", choices=("CLARABEL", "OSQP", "SCS"), help="solver")
-    _verbosity(compare)
-    compare.set_defaults(run=_run_compare)
 
     push = _subcommand(
         commands, "push", "simulate a part pushed across its support (a push file)",
-        "fixplan push problems/push-box-point.toml --report out/",
+        "fixplan push problems/push-box-finger.toml --report out/",
+        _run_push,
     )  # fmt: skip
     push.add_argument("file", type=Path, help='push file (TOML, kind = "push")')
-    push.add_argument("--json", action="store_true", help="print one JSON document")
     push.add_argument("--report", type=Path, metavar="DIR", help="write a report folder")
-    _verbosity(push)
-    push.set_defaults(run=_run_push)
 
     fit = _subcommand(
         commands, "fit", "fit a limit surface to measured loads (and twists) in a CSV file",
         "fixplan fit measurements.csv --model quartic --report out/",
+        _run_fit,
     )  # fmt: skip
     fit.add_argument(
         "file", type=Path, help="CSV file: columns fx, fy, m [N, N, N m], optionally vx, vy, w "
@@ -203,16 +202,7 @@ def _build_parser() -> argparse.ArgumentParser:
     )  # fmt: skip
     fit.add_argument("--save", type=Path, metavar="FIT.json", help="write the fit as JSON")
     fit.add_argument("--report", type=Path, metavar="DIR", help="write a report folder")
-    fit.add_argument("--json", action="store_true", help="print one JSON document")
-    _verbosity(fit)
-    fit.set_defaults(run=_run_fit)
     return parser
-
-
-def _verbosity(parser: argparse.ArgumentParser) -> None:
-    group = parser.add_mutually_exclusive_group()
-    group.add_argument("-q", "--quiet", action="store_true", help="errors only on stderr")
-    group.add_argument("-v", "--verbose", action="store_true", help="more detail on stderr")
 
 
 class _Progress:
