@@ -13,14 +13,11 @@ import itertools
 
 import numpy as np
 import pytest
+from polygon_cells import edge_sum_kernel
 from scipy.integrate import quad_vec
 
 from fixplan.surface.disk_kernel import DiskKernel
 from fixplan.surface.function_kernel import FunctionKernel
-from fixplan.surface.geometry import signed_area, triangulate
-from fixplan.surface.point_kernel import PointSetKernel
-from fixplan.surface.polygon_kernel import EdgeSumKernel, polygon_edges
-from fixplan.surface.rules import triangle_rule
 
 SMOOTH = 1e-9  # relative accuracy required for smooth fields
 HERTZ = 1e-7  # ... and for the Hertz profile (square-root edge)
@@ -192,22 +189,6 @@ RECTANGLE_CORS = {
     "outside": (0.8, 0.3),
     "far": (3.0, 2.0),
 }
-
-
-def edge_sum_kernel(cells):
-    """Exact kernel of uniform polygon cells ``[(vertices, pressure)]`` (unit total force)."""
-    force = sum(pressure * signed_area(vertices) for vertices, pressure in cells)
-    starts, ends, weights, points, far_weights = [], [], [], [], []
-    for vertices, pressure in cells:
-        s, e = polygon_edges(vertices)
-        starts.append(s)
-        ends.append(e)
-        weights.append(np.full(len(s), pressure / force))
-        pts, w = triangle_rule(triangulate(vertices), 12)
-        points.append(pts)
-        far_weights.append(w * pressure / force)
-    far = PointSetKernel(np.concatenate(points), np.concatenate(far_weights))
-    return EdgeSumKernel(np.concatenate(starts), np.concatenate(ends), np.concatenate(weights), far)
 
 
 @pytest.mark.parametrize("where", RECTANGLE_CORS)

@@ -19,11 +19,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from polygon_cells import edge_sum_kernel
 
-from fixplan.surface.geometry import signed_area, triangulate
-from fixplan.surface.point_kernel import PointSetKernel
-from fixplan.surface.polygon_kernel import EdgeSumKernel, polygon_edges
-from fixplan.surface.rules import triangle_rule
+from fixplan.surface.geometry import signed_area
+from fixplan.surface.polygon_kernel import polygon_edges
 
 QUADRATURE_RTOL = 1e-13  # analytic Hessian vs the polar quadrature (relative to its largest entry)
 DIFFERENCE_RTOL = 1e-7  # analytic Hessian vs central differences of the gradient
@@ -58,22 +57,6 @@ SHAPES = {
     "arrow head": [(ARROW, 1.0)],
     "tactile grid": grid_cells(),
 }
-
-
-def kernel_of(cells):
-    """The kernel of uniform polygon cells ``[(vertices, pressure)]`` (unit total force)."""
-    force = sum(pressure * signed_area(vertices) for vertices, pressure in cells)
-    starts, ends, weights, points, far_weights = [], [], [], [], []
-    for vertices, pressure in cells:
-        s, e = polygon_edges(vertices)
-        starts.append(s)
-        ends.append(e)
-        weights.append(np.full(len(s), pressure / force))
-        pts, w = triangle_rule(triangulate(vertices), 12)
-        points.append(pts)
-        far_weights.append(w * pressure / force)
-    far = PointSetKernel(np.concatenate(points), np.concatenate(far_weights))
-    return EdgeSumKernel(np.concatenate(starts), np.concatenate(ends), np.concatenate(weights), far)
 
 
 def centres(cells):
@@ -140,7 +123,7 @@ CASES = [(shape, where) for shape in SHAPES for where in centres(SHAPES[shape])]
 @pytest.mark.parametrize(("shape", "where"), CASES)
 def test_the_hessian_is_the_polar_quadrature_of_the_integral(shape, where):
     cells = SHAPES[shape]
-    kernel = kernel_of(cells)
+    kernel = edge_sum_kernel(cells)
     c = centres(cells)[where]
     reference = polar_hessian(cells, c)
     scale = np.max(np.abs(reference))
@@ -169,7 +152,7 @@ SMOOTH_CENTRES = ("inside", "outside", "far")
 
 @pytest.mark.parametrize("shape", SHAPES)
 def test_the_hessian_is_the_derivative_of_the_exact_gradient(shape):
-    kernel = kernel_of(SHAPES[shape])
+    kernel = edge_sum_kernel(SHAPES[shape])
     rng = np.random.default_rng(7)
     size = kernel.size
     # Random twists (centres of rotation near and far), pure translations and the centres above.
