@@ -268,12 +268,12 @@ def test_a_failed_run_writes_no_report(tmp_path, capsys):
 
 
 def test_a_report_that_fails_midway_leaves_nothing_behind(tmp_path, capsys, monkeypatch):
-    from fixplan.io import report as report_module
+    from fixplan.io import report_document
 
     def broken(*args):
-        raise report_module.ReportError("cannot write: disk full")
+        raise report_document.ReportError("cannot write: disk full")
 
-    monkeypatch.setattr(report_module, "to_html", broken)
+    monkeypatch.setattr(report_document, "to_html", broken)
     report = tmp_path / "out" / "report"
     assert main(["plan", str(write(tmp_path)), "--report", str(report)]) == EXIT_INVALID_INPUT
     assert "disk full" in capsys.readouterr().err

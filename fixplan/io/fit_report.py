@@ -37,13 +37,10 @@ from fixplan.io.report_document import (
     Image,
     List,
     Paragraph,
-    ReportError,
     Table,
     Writer,
     inline,
     staged_folder,
-    to_html,
-    to_markdown,
 )
 from fixplan.motion import Fit, FitErrors, FittedQuartic
 from fixplan.motion.fitted_quartic import MONOMIALS
@@ -204,18 +201,12 @@ def write_fit_report(directory, data: FitData, fit: Fit) -> list[Path]:
     loads, twists = data.fit_loads, data.twists
     with staged_folder(directory) as staging:
         writer = Writer(staging)
-        target = staging / "fit.json"
-        try:
-            fit.save(target)
-        except OSError as exc:
-            raise ReportError(f"cannot write {target}: {exc.strerror or exc}") from exc
-        writer.written.append(target)
+        writer.save("fit.json", fit.save)
         writer.figure("sections.png", lambda: fit_figures.fit_sections_figure(fit, loads))
         writer.figure("errors.png", lambda: fit_figures.fit_errors_figure(fit, loads, twists))
         known = fit_figures.fit_split(fit, loads).known
         blocks = _document(data, summary, known)
-        writer.write("report.md", to_markdown(blocks).encode())
-        writer.write("report.html", to_html(blocks, f"fixplan fit: {data.path.name}").encode())
+        writer.document(blocks, f"fixplan fit: {data.path.name}")
     return [directory / path.name for path in writer.written]
 
 

@@ -31,13 +31,10 @@ from fixplan.io.report_document import (
     Image,
     List,
     Paragraph,
-    ReportError,
     Table,
     Writer,
     inline,
     staged_folder,
-    to_html,
-    to_markdown,
 )
 from fixplan.motion import Trajectory
 from fixplan.motion.pushing import MODES
@@ -121,12 +118,7 @@ def write_push_report(directory, push_file: PushFile, trajectory: Trajectory) ->
         writer.write("push.json", (json.dumps(summary, indent=2, sort_keys=True) + "\n").encode())
         writer.write("trajectory.csv", trajectory_csv(trajectory).encode())
         writer.figure("trajectory.png", lambda: figures.trajectory_figure(trajectory))
-        gif = staging / "trajectory.gif"
-        try:
-            figures.save_gif(trajectory, gif)
-        except OSError as exc:
-            raise ReportError(f"cannot write {gif}: {exc.strerror or exc}") from exc
-        writer.written.append(gif)
+        writer.save("trajectory.gif", lambda path: figures.save_gif(trajectory, path))
         blocks = [
             Heading(1, inline(f"fixplan push report: {push_file.name}")),
             Paragraph(inline(f"Input file SHA-256 {push_file.sha256}.")),
@@ -141,8 +133,7 @@ def write_push_report(directory, push_file: PushFile, trajectory: Trajectory) ->
             ),
             Image("trajectory.gif", "animation", inline("The push, animated.")),
         ]
-        writer.write("report.md", to_markdown(blocks).encode())
-        writer.write("report.html", to_html(blocks, f"fixplan push: {push_file.name}").encode())
+        writer.document(blocks, f"fixplan push: {push_file.name}")
     return [directory / path.name for path in writer.written]
 
 

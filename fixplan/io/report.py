@@ -45,8 +45,6 @@ from fixplan.io.report_document import (
     Writer,
     inline,
     staged_folder,
-    to_html,
-    to_markdown,
 )
 from fixplan.planner.contact_surface import COMPONENTS, ContactSetSurface
 from fixplan.planner.plan import Plan
@@ -478,8 +476,7 @@ def _write_files(writer: Writer, problem_file: ProblemFile, plan: Plan, planner,
     if notes:
         blocks.append(List(tuple(inline(note) for note in notes)))
     title = f"fixplan report: {problem_file.name}"
-    writer.write("report.md", to_markdown(blocks).encode("utf-8"))
-    writer.write("report.html", to_html(blocks, title).encode("utf-8"))
+    writer.document(blocks, title)
 
 
 __all__ = ["ReportError", "default_sliding_subspace", "write_report"]

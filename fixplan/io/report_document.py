@@ -177,21 +177,25 @@ class Writer:
         self.directory = directory
         self.written: list[Path] = []
 
-    def write(self, name: str, content: bytes) -> None:
+    def save(self, name: str, save: Callable[[Path], object]) -> None:
+        """Write the file ``name`` with ``save(path)``; an OS error becomes a ReportError."""
         path = self.directory / name
         try:
-            path.write_bytes(content)
+            save(path)
         except OSError as exc:
             raise ReportError(f"cannot write {path}: {exc.strerror or exc}") from exc
         self.written.append(path)
 
+    def write(self, name: str, content: bytes) -> None:
+        self.save(name, lambda path: path.write_bytes(content))
+
     def figure(self, name: str, draw: Callable[[], object]) -> None:
-        path = self.directory / name
-        try:
-            figures.save_png(draw(), path)
-        except OSError as exc:
-            raise ReportError(f"cannot write {path}: {exc.strerror or exc}") from exc
-        self.written.append(path)
+        self.save(name, lambda path: figures.save_png(draw(), path))
+
+    def document(self, blocks: Sequence[Block], title: str) -> None:
+        """``report.md`` and ``report.html`` of ``blocks``."""
+        self.write("report.md", to_markdown(blocks).encode("utf-8"))
+        self.write("report.html", to_html(blocks, title).encode("utf-8"))
 
 
 @contextlib.contextmanager
