@@ -3,9 +3,16 @@ updated from slip onsets.
 
 Built on the limit surfaces and models of the layers below, without changing their conventions;
 imports only from :mod:`fixplan.planner`, :mod:`fixplan.models`, :mod:`fixplan.surface` and the
-top-level modules.
+top-level modules. Compliant contacts (paper §4.4) in :mod:`fixplan.motion.compliance`.
 """
 
+from fixplan.motion.compliance import (
+    ComplianceError,
+    ComplianceResult,
+    Stiffness,
+    analyse,
+    hertz_sphere,
+)
 from fixplan.motion.fit_report import Fit, FitErrors, FitReport, assess
 from fixplan.motion.fitted_quartic import FittedQuartic
 from fixplan.motion.identify import ellipsoid_from_matrix, fit, synthetic
@@ -19,6 +26,8 @@ from fixplan.motion.slip import ScaledSurface, SlipEstimator
 from fixplan.motion.trajectory import Trajectory, push
 
 __all__ = [
+    "ComplianceError",
+    "ComplianceResult",
     "FacePoints",
     "Fit",
     "FitErrors",
@@ -33,10 +42,13 @@ __all__ = [
     "Settling",
     "Sliding",
     "SlipEstimator",
+    "Stiffness",
     "Trajectory",
+    "analyse",
     "assess",
     "ellipsoid_from_matrix",
     "fit",
+    "hertz_sphere",
     "line_push_step",
     "motion_cone",
     "push",

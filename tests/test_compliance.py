@@ -1,0 +1,226 @@
+"""Compliant contacts against closed forms and statics written here (issue 12)."""
+
+import numpy as np
+import pytest
+
+from fixplan.motion.compliance import ComplianceError, Stiffness, analyse, hertz_sphere
+from fixplan.planner.problem import Body, Contact, Load, Problem
+from fixplan.surface import pressure
+
+#: Forces from the polished QP agree with the closed forms to this fraction of the force scale.
+RTOL = 1e-9
+NO_GRAVITY = np.zeros(3)
+
+
+def _point(name, role, position, normal, *, mu=0.5, force=None):
+    return Contact(
+        name=name,
+        role=role,
+        position=position,
+        normal=normal,
+        mu=mu,
+        model="point-cone",
+        force=force,
+    )
+
+
+def _problem(contacts, loads, *, mass=0.0, centre=(0.0, 0.0, 0.0), gravity=NO_GRAVITY):
+    body = Body(mass=mass, center_of_mass=np.array(centre), gravity=np.array(gravity))
+    return Problem(body=body, contacts=tuple(contacts), loads=tuple(loads), objective="check")
+
+
+def _pinch(load, *, area=False):
+    """Two fingers at x = ∓0.05 m squeezing with 10 N each."""
+    model = (
+        {"model": "ellipsoid", "patch": pressure.disk(0.005)} if area else {"model": "point-cone"}
+    )
+    fingers = [
+        Contact(name=n, role="finger", position=p, normal=d, mu=0.8, force=10.0, **model)
+        for n, p, d in (("a", [-0.05, 0, 0], [1, 0, 0]), ("b", [0.05, 0, 0], [-1, 0, 0]))
+    ]
+    return _problem(fingers, [load])
+
+
+def _world_force(problem, result, case, name):
+    contact = next(c for c in problem.contacts if c.name == name)
+    fn, ft1, ft2, _ = result.wrenches[case][name]
+    return np.array([ft1, ft2, fn]) @ contact.frame
+
+
+@pytest.mark.parametrize(("ka", "kb"), [(1e6, 1e6), (1e6, 4e6), (3e7, 2e5)])
+def test_axial_force_changes_pinch_forces_in_proportion_to_normal_stiffness(ka, kb):
+    force = 3.0
+    problem = _pinch(Load(name="push", force=np.array([force, 0, 0]), point=np.zeros(3)))
+    stiffness = {
+        "a": Stiffness(normal=ka, tangential=1e5),
+        "b": Stiffness(normal=kb, tangential=1e5),
+    }
+    result = analyse(problem, None, stiffness=stiffness)
+    # The body moves x = F / (ka + kb) towards b: a unloads by ka x, b loads by kb x.
+    shift = force / (ka + kb)
+    assert result.wrenches["push"]["a"][0] == pytest.approx(10.0 - ka * shift, rel=RTOL)
+    assert result.wrenches["push"]["b"][0] == pytest.approx(10.0 + kb * shift, rel=RTOL)
+    assert result.displacement["push"][0] == pytest.approx(shift, rel=RTOL)
+    assert result.lifted["push"] == ()
+
+
+@pytest.mark.parametrize(("ra", "rb"), [(2.0, 2.0), (1.0, 5.0)])
+def test_torque_about_the_axis_splits_in_proportion_to_torsional_stiffness(ra, rb):
+    torque = 0.004
+    load = Load(name="twist", force=np.zeros(3), point=np.zeros(3), torque=np.array([torque, 0, 0]))
+    problem = _pinch(load, area=True)
+    stiffness = {
+        "a": Stiffness(normal=1e6, tangential=1e5, torsional=ra),
+        "b": Stiffness(normal=1e6, tangential=1e5, torsional=rb),
+    }
+    result = analyse(problem, None, stiffness=stiffness)
+    # Rotation θ = T / (ra + rb) about +x; a's normal is +x, b's is -x.
+    angle = torque / (ra + rb)
+    assert result.wrenches["twist"]["a"][3] == pytest.approx(-ra * angle, rel=RTOL)
+    assert result.wrenches["twist"]["b"][3] == pytest.approx(rb * angle, rel=RTOL)
+    assert result.displacement["twist"][3] == pytest.approx(angle, rel=RTOL)
+
+
+@pytest.mark.parametrize(("ta", "tb"), [(1e5, 1e5), (1e5, 9e5), (4e6, 1e4)])
+def test_force_across_the_axis_at_its_midpoint_splits_evenly(ta, tb):
+    across = np.array([0.0, 1.5, -2.0])
+    problem = _pinch(Load(name="side", force=across, point=np.zeros(3)))
+    stiffness = {
+        "a": Stiffness(normal=1e6, tangential=ta),
+        "b": Stiffness(normal=3e6, tangential=tb),
+    }
+    result = analyse(problem, None, stiffness=stiffness)
+    for name in ("a", "b"):
+        tangential = _world_force(problem, result, "side", name)
+        tangential[0] = 0.0
+        np.testing.assert_allclose(tangential, -across / 2, atol=RTOL * 10)
+        assert result.wrenches["side"][name][0] == pytest.approx(10.0, rel=RTOL)
+
+
+def _plate(stiffnesses):
+    supports = [("s1", [0.0, 0.0]), ("s2", [0.3, 0.0]), ("s3", [0.1, 0.2])]
+    contacts = [_point(n, "support", [x, y, 0.0], [0, 0, 1]) for n, (x, y) in supports]
+    contacts.append(_point("clamp", "clamp", [0.12, 0.08, 0.02], [0, 0, -1], mu=0.0, force=40.0))
+    load = Load(name="drill", force=np.array([0, 0, -25.0]), point=np.array([0.2, 0.05, 0.02]))
+    problem = _problem(
+        contacts, [load], mass=2.0, centre=(0.15, 0.07, 0.01), gravity=(0.0, 0.0, -9.81)
+    )
+    stiffness = {
+        c.name: Stiffness(normal=k, tangential=k / 3)
+        for c, k in zip(contacts, stiffnesses, strict=True)
+    }
+    return problem, analyse(problem, None, stiffness=stiffness), supports
+
+
+@pytest.mark.parametrize("stiffnesses", [[1e7] * 4, [1e6, 5e7, 2e7, 3e5], [8e8, 1e5, 1e6, 1e9]])
+def test_plate_on_three_supports_carries_the_statically_determinate_reactions(stiffnesses):
+    _, result, supports = _plate(stiffnesses)
+    # Downward vertical forces (clamp, load, weight) at their (x, y): three reactions by statics.
+    downs = [(40.0, 0.12, 0.08), (25.0, 0.2, 0.05), (2.0 * 9.81, 0.15, 0.07)]
+    matrix = np.array(
+        [[1.0, 1.0, 1.0], [x for _, (x, _) in supports], [y for _, (_, y) in supports]]
+    )
+    rhs = np.array([sum(f for f, _, _ in downs), sum(f * x for f, x, _ in downs)])
+    rhs = np.r_[rhs, sum(f * y for f, _, y in downs)]
+    reactions = np.linalg.solve(matrix, rhs)
+    for (name, _), reaction in zip(supports, reactions, strict=True):
+        fn, ft1, ft2, mn = result.wrenches["drill"][name]
+        assert fn == pytest.approx(reaction, rel=RTOL)
+        assert abs(ft1) + abs(ft2) + abs(mn) < RTOL * reaction
+    assert result.wrenches["drill"]["clamp"][0] == pytest.approx(40.0, rel=RTOL)
+
+
+def test_a_part_tipped_by_a_moment_lifts_one_spring_and_rests_on_three():
+    corners = {"pp": (0.1, 0.1), "pm": (0.1, -0.1), "mp": (-0.1, 0.1), "mm": (-0.1, -0.1)}
+    contacts = [_point(n, "support", [x, y, 0.0], [0, 0, 1]) for n, (x, y) in corners.items()]
+    # Linear springs would give f = 2.5 + 15 x + 15 y [N]: -0.5 N at "mm", so it lifts off.
+    tip = Load(name="tip", force=np.zeros(3), point=np.zeros(3), torque=np.array([-0.6, 0.6, 0]))
+    problem = _problem(contacts, [tip], mass=1.0, centre=(0, 0, 0.05), gravity=(0, 0, -10.0))
+    result = analyse(problem, None, stiffness=Stiffness(normal=2e6, tangential=5e5))
+    # The other three are determinate: Σf = 10, Σ x f = My = 0.6, Σ y f = -Mx = 0.6.
+    rest = ["pp", "pm", "mp"]
+    matrix = np.array([[1.0] * 3, [corners[n][0] for n in rest], [corners[n][1] for n in rest]])
+    expected = np.linalg.solve(matrix, [10.0, 0.6, 0.6])
+    assert result.lifted["tip"] == ("mm",)
+    assert result.wrenches["tip"]["mm"] == (0.0, 0.0, 0.0, 0.0)
+    for name, force in zip(rest, expected, strict=True):
+        assert result.wrenches["tip"][name][0] == pytest.approx(force, rel=RTOL)
+
+
+def _tangents(normal):
+    """Two unit vectors spanning the plane normal to ``normal`` (from an SVD)."""
+    return np.linalg.svd(np.asarray(normal, float)[None, :])[2][1:]
+
+
+def test_displacement_of_a_3_2_1_fixture_solves_the_assembled_stiffness_matrix():
+    box = 0.1
+    places = [
+        ("z1", [0.02, 0.02, 0], [0, 0, 1]),
+        ("z2", [0.08, 0.02, 0], [0, 0, 1]),
+        ("z3", [0.05, 0.09, 0], [0, 0, 1]),
+        ("y1", [0.02, 0, 0.05], [0, 1, 0]),
+        ("y2", [0.08, 0, 0.05], [0, 1, 0]),
+        ("x1", [0, 0.05, 0.05], [1, 0, 0]),
+    ]
+    contacts = [_point(n, "locator", p, d) for n, p, d in places]
+    centre = np.full(3, box / 2)
+    load = Load(name="unit", force=np.array([-0.3, -0.4, -0.866]), point=centre)
+    problem = _problem(contacts, [load], centre=centre)
+    kn, kt = 2e7, 6e6
+    result = analyse(problem, None, stiffness=Stiffness(normal=kn, tangential=kt))
+    matrix = np.zeros((6, 6))
+    for _, position, normal in places:
+        arm = np.asarray(position, float) - centre
+        for k, direction in [(kn, np.asarray(normal, float))] + [
+            (kt, t) for t in _tangents(normal)
+        ]:
+            column = np.r_[direction, np.cross(arm, direction)]
+            matrix += k * np.outer(column, column)
+    expected = np.linalg.solve(matrix, np.r_[load.force, 0, 0, 0])
+    assert result.lifted["unit"] == ()
+    np.testing.assert_allclose(result.displacement["unit"], expected, rtol=1e-8, atol=1e-20)
+    np.testing.assert_array_equal(result.clamped_displacement["unit"], np.zeros(6))
+
+
+def test_first_slip_of_a_pinch_pulled_along_the_surface_matches_coulomb():
+    # Fingers with equal stiffness share a force F across the axis: each slips when F/2 = mu 10.
+    problem = _pinch(Load(name="pull", force=np.array([0, 0, -2.0]), point=np.zeros(3)))
+    result = analyse(problem, None, stiffness=Stiffness(normal=1e6, tangential=1e5))
+    assert result.first_slip["pull"] == pytest.approx(2 * 0.8 * 10.0 / 2.0, rel=1e-8)
+    assert result.safety_factors["pull"]["a"] == pytest.approx(0.8 * 10.0 / 1.0, rel=RTOL)
+    slip = result.slip_directions["pull"]["a"]
+    contact = problem.contacts[0]
+    world = slip[:2] @ contact.frame[:2]
+    np.testing.assert_allclose(world, [0, 0, -1], atol=1e-9)
+
+
+def test_hertz_sphere_slope_matches_a_difference_of_hertz_law():
+    young, nu = 2.1e11, 0.3
+    e_star = 1 / (2 * (1 - nu**2) / young)
+    radius, preload = 0.005, 50.0
+    approach = (3 * preload / (4 * e_star * np.sqrt(radius))) ** (2 / 3)
+    step = approach * 1e-6
+    law = lambda d: 4 / 3 * e_star * np.sqrt(radius) * d**1.5  # noqa: E731
+    slope = (law(approach + step) - law(approach - step)) / (2 * step)
+    stiffness = hertz_sphere(
+        radius=radius, preload=preload, young=young, poisson=nu, young_flat=young, poisson_flat=nu
+    )
+    assert stiffness.normal == pytest.approx(slope, rel=1e-8)
+    # Mindlin over Hertz for equal materials: k_t / k_n = 8 G* / (2 E*) = 2 (1 - nu) / (2 - nu).
+    assert stiffness.tangential / stiffness.normal == pytest.approx(2 * (1 - nu) / (2 - nu))
+
+
+@pytest.mark.parametrize(
+    "arguments", [{"normal": 0.0, "tangential": 1.0}, {"normal": 1.0, "tangential": -1.0}]
+)
+def test_stiffness_rejects_values_out_of_range(arguments):
+    with pytest.raises(ComplianceError, match="stiffness"):
+        Stiffness(**arguments)
+
+
+def test_a_load_that_pulls_the_part_off_its_supports_is_an_error():
+    contacts = [_point(n, "support", [x, 0, 0], [0, 0, 1]) for n, x in (("l", -0.1), ("r", 0.1))]
+    lift = Load(name="lift", force=np.array([0, 0, 5.0]), point=np.zeros(3))
+    problem = _problem(contacts, [lift])
+    with pytest.raises(ComplianceError, match=r"'lift'.*leaves its contacts"):
+        analyse(problem, None, stiffness=Stiffness(normal=1e6, tangential=1e5))
