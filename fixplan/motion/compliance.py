@@ -28,8 +28,10 @@ Loading happens in two steps.
    the locators and supports are springs that start just touching. Their reactions balance the
    preloads (gravity is not part of this step, so that a grasp without supports, whose preloads
    balance each other, is well posed).
-2. **Task.** The clamps and fingers lock: every contact becomes a spring about its clamped
-   state, and gravity plus ``λ`` times the task load are applied. ``λ = 1`` is the load case.
+2. **Task.** Every contact becomes a spring about its clamped state, except that a clamp's
+   normal force stays at its preload (a force-controlled clamp, as in the planner; its friction
+   is still a sticking spring) while a finger's normal spring acts about its preload. Gravity
+   plus ``λ`` times the task load are applied; ``λ = 1`` is the load case.
 
 Each step is the minimum of the complementary energy, a convex quadratic program solved exactly
 (Clarabel through cvxpy), whose multipliers of equilibrium are the displacement:
