@@ -41,6 +41,13 @@ def nonnegative_scalar(name: str, value: object) -> float:
     return number + 0.0
 
 
+def positive_int(name: str, value: object) -> int:
+    """Return ``value`` as an int >= 1 (booleans are refused)."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
+        raise InvalidArgumentError(f"{name} must be a positive integer, got {value!r}")
+    return int(value)
+
+
 def finite_array(name: str, value: object, *, shape: tuple[int | None, ...]) -> np.ndarray:
     """Return ``value`` as a read-only float array of ``shape`` (``None`` = any length)."""
     try:

@@ -162,7 +162,8 @@ def test_displacement_of_a_3_2_1_fixture_solves_the_assembled_stiffness_matrix()
         ("y2", [0.08, 0, 0.05], [0, 1, 0]),
         ("x1", [0, 0.05, 0.05], [1, 0, 0]),
     ]
-    contacts = [_point(n, "locator", p, d) for n, p, d in places]
+    # Friction high enough that no locator slips under the unit load (the springs stay linear).
+    contacts = [_point(n, "locator", p, d, mu=2.0) for n, p, d in places]
     centre = np.full(3, box / 2)
     load = Load(name="unit", force=np.array([-0.3, -0.4, -0.866]), point=centre)
     problem = _problem(contacts, [load], centre=centre)
@@ -178,6 +179,7 @@ def test_displacement_of_a_3_2_1_fixture_solves_the_assembled_stiffness_matrix()
             matrix += k * np.outer(column, column)
     expected = np.linalg.solve(matrix, np.r_[load.force, 0, 0, 0])
     assert result.lifted["unit"] == ()
+    assert result.first_slip["unit"] > 1.0
     np.testing.assert_allclose(result.displacement["unit"], expected, rtol=1e-8, atol=1e-20)
     np.testing.assert_array_equal(result.clamped_displacement["unit"], np.zeros(6))
 
@@ -224,3 +226,112 @@ def test_a_load_that_pulls_the_part_off_its_supports_is_an_error():
     problem = _problem(contacts, [lift])
     with pytest.raises(ComplianceError, match=r"'lift'.*leaves its contacts"):
         analyse(problem, None, stiffness=Stiffness(normal=1e6, tangential=1e5))
+
+
+def test_first_slip_after_a_support_lifts_matches_statics_on_the_remaining_three():
+    # Four supports at the corners; "mm" is frictionless, so the others carry the in-plane force
+    # and, the force passing through their centroid, carry a third of it each.
+    corners = {"pp": (0.1, 0.1), "pm": (0.1, -0.1), "mp": (-0.1, 0.1), "mm": (-0.1, -0.1)}
+    contacts = [
+        _point(n, "support", [x, y, 0.0], [0, 0, 1], mu=0.0 if n == "mm" else 0.5)
+        for n, (x, y) in corners.items()
+    ]
+    push = 1.2
+    load = Load(
+        name="tip",
+        force=np.array([push, 0, 0]),
+        point=np.array([0.1, 0.1, 0.0]) / 3,
+        torque=np.array([-0.6, 0.6, 0]),
+    )
+    problem = _problem(contacts, [load], mass=1.0, centre=(0, 0, 0.05), gravity=(0, 0, -10.0))
+    result = analyse(problem, None, stiffness=Stiffness(normal=2e6, tangential=5e5))
+    # "mm" lifts at λ = 5/6; then statics on three supports gives fn(pm) = fn(mp) = 5 - 3 λ,
+    # and they slip when λ push / 3 = mu (5 - 3 λ).
+    assert result.first_slip["tip"] == pytest.approx(0.5 * 5 / (push / 3 + 0.5 * 3), rel=1e-9)
+    assert result.first_slip_contact["tip"] in ("pm", "mp")
+    assert result.lifted["tip"] == ("mm",)
+    assert result.wrenches["tip"]["pm"][0] == pytest.approx(2.0, rel=RTOL)
+
+
+def _pressed_plate(model, load):
+    """A plate on three supports pressed by a frictionless clamp: in-plane loads at the support
+    plane leave every normal force where statics puts it."""
+    patch = {"patch": pressure.disk(0.01)} if model != "point-cone" else {}
+    supports = [("s1", [0.0, 0.0]), ("s2", [0.3, 0.0]), ("s3", [0.1, 0.2])]
+    contacts = [
+        Contact(
+            name=n, role="support", position=[x, y, 0.0], normal=[0, 0, 1], mu=0.4, model=model,
+            **patch,
+        )
+        for n, (x, y) in supports
+    ]  # fmt: skip
+    contacts.append(_point("clamp", "clamp", [0.12, 0.08, 0.02], [0, 0, -1], mu=0.0, force=60.0))
+    return _problem(contacts, [load], mass=1.5, centre=(0.15, 0.07, 0.01), gravity=(0, 0, -9.81))
+
+
+@pytest.mark.parametrize("model", ["point-cone", "ellipsoid"])
+@pytest.mark.parametrize(
+    ("force", "point", "torque"),
+    [([3.0, 1.0, 0.0], [0.2, 0.1, 0.0], 0.0), ([-1.0, 2.0, 0.0], [0.0, 0.3, 0.0], 0.4)],
+)
+def test_with_normal_forces_fixed_by_statics_the_part_moves_at_the_rigid_safety_factor(
+    model, force, point, torque
+):
+    from fixplan.planner.planner import Planner
+
+    load = Load(
+        name="mill", force=np.array(force), point=np.array(point), torque=np.array([0, 0, torque])
+    )
+    problem = _pressed_plate(model, load)
+    stiffness = {
+        "s1": Stiffness(normal=1e7, tangential=3e6, torsional=20.0),
+        "s2": Stiffness(normal=4e7, tangential=1e6, torsional=5.0),
+        "s3": Stiffness(normal=2e6, tangential=8e6, torsional=50.0),
+        "clamp": Stiffness(normal=1e7, tangential=1e6),
+    }
+    result = analyse(problem, None, stiffness=stiffness)
+    rigid = Planner(problem).solve().safety_factors["mill"]
+    assert result.collapse["mill"] == pytest.approx(rigid, rel=1e-6)
+    assert result.first_slip["mill"] <= result.collapse["mill"]
+    assert result.held["mill"] == (rigid >= 1.0)
+
+
+def _random_fixture(rng):
+    """A box on three supports against two side locators and an end locator, each set pressed
+    by its own clamp, under a random load."""
+    size = np.array([0.2, 0.12, 0.05])
+    contacts = []
+    for i in range(3):
+        xy = rng.uniform(0.1, 0.9, 2) * size[:2]
+        contacts.append(_point(f"z{i}", "support", [*xy, 0.0], [0, 0, 1], mu=rng.uniform(0.2, 0.6)))
+    for i, x in enumerate(np.array([0.2, 0.8]) * size[0]):
+        z = rng.uniform(0.3, 0.7) * size[2]
+        contacts.append(_point(f"y{i}", "locator", [x, 0.0, z], [0, 1, 0], mu=0.3))
+    contacts.append(_point("x0", "locator", [0.0, size[1] / 2, size[2] / 2], [1, 0, 0], mu=0.3))
+    clamps = [
+        ("top", [*(rng.uniform(0.3, 0.7, 2) * size[:2]), size[2]], [0, 0, -1]),
+        ("side", [size[0] / 2, size[1], size[2] / 2], [0, -1, 0]),
+        ("end", [size[0], size[1] / 2, size[2] / 2], [-1, 0, 0]),
+    ]
+    for name, position, normal in clamps:
+        force = rng.uniform(50.0, 200.0)
+        contacts.append(_point(name, "clamp", position, normal, mu=0.3, force=force))
+    load = Load(name="cut", force=rng.normal(size=3) * 20.0, point=rng.uniform(0, 1, 3) * size)
+    problem = _problem(contacts, [load], mass=2.0, centre=size / 2, gravity=(0, 0, -9.81))
+    stiffness = {
+        c.name: Stiffness(normal=k, tangential=k * rng.uniform(0.2, 1.0))
+        for c, k in zip(contacts, 10 ** rng.uniform(6, 8, len(contacts)), strict=True)
+    }
+    return problem, stiffness
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_over_random_fixtures_first_slip_and_collapse_never_exceed_the_rigid_safety_factor(seed):
+    from fixplan.planner.planner import Planner
+
+    problem, stiffness = _random_fixture(np.random.default_rng(seed))
+    result = analyse(problem, None, stiffness=stiffness)
+    rigid = Planner(problem, allow_squeeze=True).solve().safety_factors["cut"]
+    first, collapse = result.first_slip["cut"], result.collapse["cut"]
+    assert first <= collapse * (1 + 1e-9)
+    assert collapse <= rigid * (1 + 1e-6)

@@ -1,0 +1,280 @@
+r"""Raising the task load on a body held by contact springs: where the first contact slips, what
+the contacts carry while some slide, and where the body as a whole moves (used by
+:mod:`fixplan.motion.compliance`).
+
+Gravity stays and ``λ`` times the task load is applied, ``λ`` rising from 0.
+
+- **Up to the first slip** every contact sticks and the answer is exact and piecewise affine in
+  ``λ``: a piece keeps its set of touching contacts and ends where a touching contact's normal
+  force falls to 0 or a lifted contact's gap closes. On each piece a contact's excess
+  ``gauge(friction load) − fn`` is convex in ``λ``, so its first root is unique and found by
+  Brent's method (:func:`fixplan.motion.compliance` reports it as ``first_slip``).
+- **After it**, the load rises in increments. In each the contacts are springs about the state
+  before it, and a contact whose trial friction load leaves its friction set at its normal force
+  is returned to that set along the set's own normal (it slides with the twist its limit surface
+  gives; backward Euler). The friction bounds are the normal forces at the end of the increment,
+  found by fixed-point iteration of the convex step with the bounds fixed (Tresca's problem, the
+  classical iteration for Coulomb friction), to :data:`FIXED_POINT_RTOL`.
+- **Collapse**: the body moves as a whole at the multiple beyond which no contact forces within
+  the friction sets and unilateral limits balance the load. An increment that has no solution
+  (or none Clarabel can find accurately, as at the brink of infeasibility, or whose friction
+  bounds do not settle) is halved until the multiple is bracketed to :data:`COLLAPSE_RTOL`.
+
+The increments start at ``max(first slip, 1) / steps`` (so ``steps`` increments reach the task
+load from the first slip), shrink where an increment fails and, beyond the task load, double
+after every increment that succeeds (beyond it, only the collapse multiple is reported). Where
+normal forces do not depend on the slips (a part pressed on its supports by force-controlled
+clamps, loads in the support plane) the path does not matter and the collapse multiple is the
+rigid limit load; in general it depends on the increments (friction is not associated with the
+normal direction), and finer ``steps`` follow the path more closely.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from fixplan.errors import ConvergenceError
+from fixplan.motion.contact_springs import (
+    UNLIMITED,
+    ComplianceError,
+    InaccurateStepError,
+    NoEquilibriumError,
+    SpringSystem,
+    WrongContactSetError,
+)
+
+#: The first-slip multiple is located to this relative accuracy.
+SLIP_RTOL = 1e-10
+
+#: Contact forces below this fraction of the force scale are rounding noise.
+NEGLIGIBLE = 1e-12
+
+#: The friction bounds of an increment agree with its normal forces to this fraction of the
+#: force scale.
+FIXED_POINT_RTOL = 1e-9
+
+#: Most fixed-point iterations of one increment before it counts as failed (and is halved).
+MAX_FIXED_POINT_ITERATIONS = 30
+
+#: The collapse multiple is bracketed to this relative accuracy.
+COLLAPSE_RTOL = 1e-7
+
+
+class _FixedPointError(ComplianceError):
+    """The friction bounds of an increment did not settle."""
+
+
+@dataclass(frozen=True, slots=True)
+class State:
+    """The contacts at one multiple of the task load.
+
+    Attributes
+    ----------
+    multiple : float
+        ``λ``.
+    forces : array (m, 4)
+        Contact forces ``(fn, ft1, ft2, mn)`` [N, N m].
+    delta : array (6,)
+        Body displacement from the clamped state [m, rad].
+    would_be : array (m,)
+        Normal force of each contact's spring without the unilateral limit [N] (negative: an
+        open gap); a force-controlled contact's preload.
+    """
+
+    multiple: float
+    forces: np.ndarray
+    delta: np.ndarray
+    would_be: np.ndarray
+
+
+class LoadRamp:
+    """Gravity plus ``λ`` times the task load on the clamped contact springs.
+
+    Parameters
+    ----------
+    system : SpringSystem
+        The contact springs of the task step (force-controlled clamp normals have constant 0).
+    reference : array (m, 4)
+        The forces about which the springs act (the clamped state; an open gap as a negative
+        normal force).
+    gravity, task : array (6,)
+        The weight and the task load as wrenches about the centre of mass.
+    models : sequence of FrictionModel
+        Each contact's friction model.
+    case : str
+        The load case's name, for messages.
+    """
+
+    def __init__(self, system: SpringSystem, reference, gravity, task, models, case: str):
+        self.system, self.reference = system, reference
+        self.gravity, self.task, self.models, self.case = gravity, task, models, case
+
+    def at(self, multiple: float) -> tuple[State, np.ndarray, np.ndarray]:
+        """The elastic state at ``multiple`` (every contact sticking), exact; with which contacts
+        touch and the springs in effect."""
+        forces, delta, touching, springs, _ = self.system.solve(
+            self.reference, self.gravity + multiple * self.task, self.case
+        )
+        return State(multiple, forces, delta, self._would_be(delta)), touching, springs
+
+    def _would_be(self, delta) -> np.ndarray:
+        normal = self.system.bases[:, :, 0]
+        return self.reference[:, 0] - self.system.springs[:, 0] * (normal @ delta)
+
+    def first_slip(self, limit: float) -> tuple[float, int | None, State | None]:
+        """Smallest multiple in ``[0, limit]`` at which a sticking contact reaches its friction
+        set (with that contact and the state there), or at which the body leaves its contacts
+        (with ``None`` and the state there); ``(inf, None, None)`` when neither happens.
+        Followed piece by piece: at the end of a piece the contact whose normal force reached 0
+        lifts (or the one whose gap closed touches). Raises :class:`NoEquilibriumError` when
+        the contacts cannot balance the weight."""
+        start = 0.0
+        try:
+            state, touching, springs = self.at(start)
+        except WrongContactSetError:
+            return self._sliding_at(self.origin(), start)
+        for _ in range(4 * len(self.models) + 4):
+            zero = np.zeros_like(self.reference)
+            slope, _, motion = self.system.linear(zero, springs, self.task, touching)
+            # The piece ends where a touching contact's normal force falls to 0 or a lifted
+            # one's would-be force rises to 0.
+            rate = np.where(touching, -slope[:, 0], -self.system.springs[:, 0] * motion[:, 0])
+            value = np.where(touching, state.forces[:, 0], -state.would_be)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                crossing = value / rate
+            ahead = (rate > 0.0) & np.isfinite(crossing)
+            end = min(limit, start + float(crossing[ahead].min(initial=np.inf)))
+            best, who = np.inf, None
+            forces, slope = self._rounded(state.forces), self._rounded(slope)
+            for i, model in enumerate(self.models):
+                if touching[i]:
+                    found = _slip_root(model, forces[i], slope[i], start, end)
+                    if found is not None and found < best:
+                        best, who = found, i
+            if who is not None:
+                return best, who, self._on(best, touching)[0]
+            if end >= limit:
+                return np.inf, None, None
+            last = self._on(end, touching)[0]
+            touching = touching.copy()
+            touching[np.flatnonzero(ahead)[np.argmin(crossing[ahead])]] ^= True
+            try:
+                state, springs = self._on(end, touching)
+            except WrongContactSetError:  # several changes at once: ask the QP just after
+                try:
+                    state, touching, springs = self.at(end * (1 + SLIP_RTOL) + SLIP_RTOL)
+                except NoEquilibriumError:
+                    return end, None, last
+                except WrongContactSetError:
+                    return self._sliding_at(last, end)
+            start = end
+        raise ConvergenceError(f"load case {self.case!r}: too many changes of the lifted contacts")
+
+    def origin(self) -> State:
+        """The clamped state, before gravity and the task load."""
+        normal = self.reference[:, 0]
+        forces = self.reference.copy()
+        forces[:, 0] = np.maximum(normal, 0.0)
+        return State(0.0, forces, np.zeros(6), normal.copy())
+
+    def _sliding_at(self, state: State, multiple: float) -> tuple[float, int, State]:
+        """No state with every contact sticking exists at ``multiple`` (a contact at the verge of
+        lifting would have to carry friction): the state there with its sliding contacts, from
+        ``state``, and the contact that uses most of its friction set."""
+        reached = self.increment(state, multiple)
+        usage = np.zeros(len(self.models))
+        for i, (model, (fn, *load)) in enumerate(zip(self.models, reached.forces, strict=True)):
+            friction = np.array(load[: model.load_dimension])
+            if fn > 0.0 and friction.any():
+                usage[i] = 1.0 / model.safety_factor(friction, normal_force=fn)
+        return multiple, int(np.argmax(usage)), reached
+
+    def _on(self, multiple: float, touching) -> tuple[State, np.ndarray]:
+        """The elastic state at ``multiple`` with the contacts ``touching`` given, and the
+        springs in effect."""
+        forces, delta, springs, _ = self.system.touching(
+            self.reference, self.gravity + multiple * self.task, touching, self.case
+        )
+        return State(multiple, forces, delta, self._would_be(delta)), springs
+
+    def _rounded(self, forces) -> np.ndarray:
+        """``forces`` ``(m, 4)`` with rounding noise (below :data:`NEGLIGIBLE` of the force
+        scale) set to 0, so that a contact without friction load lifts off, not slips."""
+        units = self.system.qp.units.reshape(-1, 4)
+        return np.where(np.abs(forces) < NEGLIGIBLE * units, 0.0, forces)
+
+    def increment(self, state: State, multiple: float) -> State:
+        """The state at ``multiple`` reached from ``state`` in one increment (see the module
+        doc); raises :class:`NoEquilibriumError` or a failed fixed point."""
+        qp = self.system.qp
+        reference = state.forces.copy()
+        reference[:, 0] = state.would_be
+        wrench = self.gravity + multiple * self.task
+        # The first bounds: the normal forces of the elastic trial (friction unlimited).
+        forces, _ = qp.solve(
+            reference, wrench, np.full(len(self.models), UNLIMITED * qp.scale), self.case
+        )
+        bound = np.maximum(forces[:, 0], 0.0)
+        for _ in range(MAX_FIXED_POINT_ITERATIONS):
+            forces, step = qp.solve(reference, wrench, bound, self.case)
+            normal = np.maximum(forces[:, 0], 0.0)
+            settled = np.abs(normal - bound).max() <= FIXED_POINT_RTOL * qp.scale
+            bound = normal
+            if settled:
+                delta = state.delta + step
+                return State(multiple, forces, delta, self._would_be(delta))
+        raise _FixedPointError(f"load case {self.case!r}: the friction bounds did not settle")
+
+    def follow(self, start: State, steps: int, limit: float) -> tuple[float, State, State | None]:
+        """Raise the load from ``start`` (the first slip) in increments: the collapse multiple
+        (``inf`` if none up to ``limit``), the last state reached and the state at the task load
+        (``None`` if the body moves before it)."""
+        base = max(start.multiple, 1.0) / steps
+        step, state, at_task = base, start, (start if start.multiple == 1.0 else None)
+        while state.multiple < limit:
+            multiple = min(state.multiple + step, limit)
+            if state.multiple < 1.0 < multiple:
+                multiple = 1.0
+            try:
+                reached = self.increment(state, multiple)
+            except (NoEquilibriumError, InaccurateStepError, _FixedPointError):
+                if multiple - state.multiple <= COLLAPSE_RTOL * max(state.multiple, base):
+                    return state.multiple, state, at_task
+                step = (multiple - state.multiple) / 2.0
+                continue
+            state = reached
+            if state.multiple == 1.0:
+                at_task = state
+            step = 2.0 * step if state.multiple >= 1.0 else min(2.0 * step, base)
+        return np.inf, state, at_task
+
+
+def _slip_root(model, forces, slope, start, end) -> float | None:
+    """First ``λ`` in ``[start, end]`` where ``gauge(L(λ)) = fn(λ)``: the excess is convex in
+    ``λ`` (a gauge of an affine load minus an affine force), so its first root is unique."""
+
+    width = 4 if model.torsion else 3
+    if not (forces[1:width].any() or slope[1:width].any()):
+        return None  # no friction load on this piece: the contact can lift off, not slip
+
+    def excess(multiple):
+        fn, *load = forces + (multiple - start) * slope
+        friction = np.array(load[: width - 1])
+        if not friction.any():
+            return -fn
+        return float(1.0 / model.safety_factor(friction, normal_force=1.0)) - fn
+
+    at_start = excess(start)
+    if at_start > 0.0:
+        return start
+    if excess(end) <= 0.0:
+        return None
+    if at_start == 0.0:  # on the limit (an unloaded contact): slips now if the excess grows
+        probe = start + SLIP_RTOL * (end - start)
+        if excess(probe) > 0.0:
+            return start
+        start = probe
+    return brentq(excess, start, end, rtol=SLIP_RTOL)
