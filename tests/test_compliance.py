@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from fixplan.motion.compliance import ComplianceError, Stiffness, analyse, hertz_sphere
+from fixplan.motion.compliance import ComplianceError, Stiffness, analyse
 from fixplan.planner.problem import Body, Contact, Load, Problem
 from fixplan.surface import pressure
 
@@ -194,22 +194,6 @@ def test_first_slip_of_a_pinch_pulled_along_the_surface_matches_coulomb():
     contact = problem.contacts[0]
     world = slip[:2] @ contact.frame[:2]
     np.testing.assert_allclose(world, [0, 0, -1], atol=1e-9)
-
-
-def test_hertz_sphere_slope_matches_a_difference_of_hertz_law():
-    young, nu = 2.1e11, 0.3
-    e_star = 1 / (2 * (1 - nu**2) / young)
-    radius, preload = 0.005, 50.0
-    approach = (3 * preload / (4 * e_star * np.sqrt(radius))) ** (2 / 3)
-    step = approach * 1e-6
-    law = lambda d: 4 / 3 * e_star * np.sqrt(radius) * d**1.5  # noqa: E731
-    slope = (law(approach + step) - law(approach - step)) / (2 * step)
-    stiffness = hertz_sphere(
-        radius=radius, preload=preload, young=young, poisson=nu, young_flat=young, poisson_flat=nu
-    )
-    assert stiffness.normal == pytest.approx(slope, rel=1e-8)
-    # Mindlin over Hertz for equal materials: k_t / k_n = 8 G* / (2 E*) = 2 (1 - nu) / (2 - nu).
-    assert stiffness.tangential / stiffness.normal == pytest.approx(2 * (1 - nu) / (2 - nu))
 
 
 @pytest.mark.parametrize(

@@ -3,7 +3,8 @@ updated from slip onsets.
 
 Built on the limit surfaces and models of the layers below, without changing their conventions;
 imports only from :mod:`fixplan.planner`, :mod:`fixplan.models`, :mod:`fixplan.surface` and the
-top-level modules. Compliant contacts (paper §4.4) in :mod:`fixplan.motion.compliance`.
+top-level modules. Compliant contacts (paper §4.4) in :mod:`fixplan.motion.compliance`; the
+stiffness of Hertzian contacts for them in :mod:`fixplan.motion.hertz`.
 """
 
 from fixplan.motion.compliance import (
@@ -11,10 +12,10 @@ from fixplan.motion.compliance import (
     ComplianceResult,
     Stiffness,
     analyse,
-    hertz_sphere,
 )
 from fixplan.motion.fit_report import Fit, FitErrors, FitReport, assess
 from fixplan.motion.fitted_quartic import FittedQuartic
+from fixplan.motion.hertz import hertz_cylinder, hertz_sphere
 from fixplan.motion.identify import ellipsoid_from_matrix, fit, synthetic
 from fixplan.motion.line_contact import line_push_step
 from fixplan.motion.outline import FacePoints, Outline
@@ -48,6 +49,7 @@ __all__ = [
     "assess",
     "ellipsoid_from_matrix",
     "fit",
+    "hertz_cylinder",
     "hertz_sphere",
     "line_push_step",
     "motion_cone",

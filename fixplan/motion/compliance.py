@@ -101,62 +101,6 @@ class Stiffness:
         object.__setattr__(self, "torsional", torsional)
 
 
-def hertz_sphere(
-    *,
-    radius: float,
-    preload: float,
-    young: float,
-    poisson: float,
-    young_flat: float,
-    poisson_flat: float,
-) -> Stiffness:
-    r"""Stiffness of a sphere pressed on a flat, linearised at its preload (Hertz, Mindlin,
-    Lubkin; Johnson, *Contact Mechanics*, §4.2, §7.2, §7.3).
-
-    With the contact modulus ``1/E* = (1 - ν1²)/E1 + (1 - ν2²)/E2``, Hertz's law between the
-    normal force and the approach ``d`` is ``F = (4/3) E* √R d^{3/2}``, with contact radius
-    ``a = √(R d) = (3 F R / (4 E*))^{1/3}``. Its slope at the preload is the normal stiffness,
-    and the sticking (no-slip) tangential and torsional stiffnesses follow from ``a``:
-
-    .. math:: k_n = \frac{dF}{dd} = 2 E^* a, \qquad k_t = 8 G^* a, \qquad
-        k_r = \tfrac{16}{3} G_r a^3,
-
-    with ``1/G* = (2 - ν1)/G1 + (2 - ν2)/G2`` (Mindlin), ``1/G_r = 1/G1 + 1/G2`` (Lubkin's
-    twist of each half-space) and ``G = E / (2 (1 + ν))``.
-
-    Parameters
-    ----------
-    radius : float
-        Sphere radius [m].
-    preload : float
-        Normal force at which the law is linearised [N], > 0.
-    young, poisson : float
-        Young's modulus [Pa] and Poisson ratio [-] of the sphere (finger tip, locator pin).
-    young_flat, poisson_flat : float
-        Those of the flat (the part).
-    """
-    try:
-        R = validation.positive_scalar("radius", radius)
-        F = validation.positive_scalar("preload", preload)
-        materials = [
-            (validation.positive_scalar(f"young{s}", e), validation.finite_scalar(f"poisson{s}", v))
-            for s, e, v in (("", young, poisson), ("_flat", young_flat, poisson_flat))
-        ]
-    except InvalidArgumentError as exc:
-        raise ComplianceError(str(exc)) from None
-    for (_, nu), side in zip(materials, ("poisson", "poisson_flat"), strict=True):
-        if not -1.0 < nu < 0.5:
-            raise ComplianceError(f"{side} must lie in (-1, 0.5), got {nu!r}")
-    shear = [e / (2.0 * (1.0 + nu)) for e, nu in materials]
-    e_star = 1.0 / sum((1.0 - nu**2) / e for e, nu in materials)
-    g_star = 1.0 / sum((2.0 - nu) / g for (_, nu), g in zip(materials, shear, strict=True))
-    g_twist = 1.0 / sum(1.0 / g for g in shear)
-    a = (3.0 * F * R / (4.0 * e_star)) ** (1.0 / 3.0)
-    return Stiffness(
-        normal=2.0 * e_star * a, tangential=8.0 * g_star * a, torsional=16.0 / 3.0 * g_twist * a**3
-    )
-
-
 @dataclass(frozen=True, slots=True, kw_only=True)
 class ComplianceResult:
     """The compliant analysis of a problem, per load case name (and contact name).
