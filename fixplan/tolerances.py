@@ -100,6 +100,15 @@ MAX_MU = 100.0
 #: normal forces (give 0 for a frictionless contact where the model allows it).
 MIN_MU = 1e-6
 
+#: Largest contact stiffness of a problem file [N/m, torsional N m/rad] (a steel contact a
+#: metre across is about 1e12 N/m).
+MAX_STIFFNESS = 1e13
+
+#: Smallest positive contact stiffness of a problem file [N/m, torsional N m/rad]: softer
+#: springs leave a compliant analysis too badly scaled to solve (give 0 for no tangential or
+#: torsional spring).
+MIN_STIFFNESS = 1e-6
+
 #: Most facets of a pyramid model.
 MAX_FACETS = 64
 

@@ -6,7 +6,9 @@ import numpy as np
 import pytest
 
 from fixplan.errors import FixplanError, InvalidArgumentError
+from fixplan.io import problem_file as problem_file_module
 from fixplan.io.problem_file import Issue, ProblemFile, ProblemFileError, load_problem
+from fixplan.motion import ComplianceError, Stiffness
 from fixplan.surface.pressure import DiskField, GridField, PolygonField
 
 HEADER = """\
@@ -587,3 +589,124 @@ def test_malformed_documents_raise_only_problem_file_errors(tmp_path, text):
 def test_an_integer_too_large_for_a_float_is_an_issue_not_a_crash(tmp_path):
     text = _edited(VALID, ("mass = 2.0", "mass = 1" + "0" * 400))
     _assert_issue(_issues(tmp_path, text), "body.mass", "too large")
+
+
+# -- contact stiffnesses (the compliant analysis) --------------------------------------------------
+
+DEFAULT_STIFFNESS = (
+    'model = "ellipsoid"\nstiffness = { normal = 1e8, tangential = 5e7, torsional = 30 }\n'
+)
+OWN_STIFFNESS = "max_force = 2000.0\nstiffness = { normal = 2e8, tangential = 6e7 }"
+
+
+def _with_stiffness(*edits):
+    return _edited(VALID, ('model = "ellipsoid"\n', DEFAULT_STIFFNESS), *edits)
+
+
+def test_a_file_without_stiffness_carries_none(tmp_path):
+    assert load_problem(_write(tmp_path, VALID)).stiffness is None
+
+
+def test_defaults_give_every_contact_its_stiffness_and_a_contact_table_replaces_it_whole(tmp_path):
+    text = _with_stiffness(("max_force = 2000.0", OWN_STIFFNESS))
+    stiffness = load_problem(_write(tmp_path, text)).stiffness
+    default = Stiffness(normal=1e8, tangential=5e7, torsional=30.0)
+    assert stiffness == {
+        "jaw-fixed": default,
+        "jaw-moving": Stiffness(normal=2e8, tangential=6e7),
+        "rest": default,
+    }
+
+
+def test_a_stiffness_may_be_given_for_some_contacts_only(tmp_path):
+    text = _edited(VALID, ("max_force = 2000.0", OWN_STIFFNESS))
+    loaded = load_problem(_write(tmp_path, text))
+    assert loaded.stiffness == {"jaw-moving": Stiffness(normal=2e8, tangential=6e7)}
+    assert not hasattr(loaded.problem.contacts[1], "stiffness")
+
+
+@pytest.mark.parametrize(
+    ("table", "key_path", "fragment"),
+    [
+        ("{ normal = 0, tangential = 5e7 }", ".normal", "expected a number > 0, got 0"),
+        ("{ normal = -1e8, tangential = 5e7 }", ".normal", "expected a number > 0"),
+        ("{ normal = nan, tangential = 5e7 }", ".normal", "expected a finite number"),
+        ("{ normal = 1e14, tangential = 5e7 }", ".normal", "and at most 1e+13 N/m, got 1"),
+        ("{ normal = 1e-9, tangential = 5e7 }", ".normal", "below 1e-06 (springs that soft"),
+        ("{ normal = '1e8', tangential = 5e7 }", ".normal", "expected a number, got string"),
+        ("{ tangential = 5e7 }", ".normal", "missing required key; expected a number > 0"),
+        ("{ normal = 1e8 }", ".tangential", "missing required key; expected a number >= 0"),
+        ("{ normal = 1e8, tangential = -1 }", ".tangential", "expected a number >= 0"),
+        ("{ normal = 1e8, tangential = 1e-9 }", ".tangential", "or give 0)"),
+        ("{ normal = 1e8, tangential = 0, torsional = true }", ".torsional", "got boolean"),
+        ("{ normal = 1e8, tangential = 0, torsional = 1e14 }", ".torsional", "1e+13 N m/rad"),
+        ("{ normal = 1e8, tangential = 0, torsion = 1 }", ".torsion", "did you mean 'torsional'"),
+        ("5e7", "", "expected a table, got float 50000000.0"),
+    ],
+)
+def test_each_stiffness_mistake_is_reported_at_its_key_path(tmp_path, table, key_path, fragment):
+    for edits, where in (
+        ([("max_force = 2000.0", f"max_force = 2000.0\nstiffness = {table}")], "contacts[1]"),
+        ([('model = "ellipsoid"\n', f'model = "ellipsoid"\nstiffness = {table}\n')], "defaults"),
+    ):
+        issues = _issues(tmp_path, _edited(VALID, *edits))
+        _assert_issue(issues, f"{where}.stiffness{key_path}", fragment)
+
+
+def test_a_stiffness_the_library_rejects_is_an_issue_at_the_table(tmp_path, monkeypatch):
+    def rejected(**values):
+        raise ComplianceError("stiffness.normal must be finite [N/m, N/m, N m/rad]")
+
+    monkeypatch.setattr(problem_file_module, "Stiffness", rejected)
+    text = _edited(VALID, ("max_force = 2000.0", OWN_STIFFNESS))
+    _assert_issue(_issues(tmp_path, text), "contacts[1].stiffness", "must be finite")
+
+
+COMPLIANT = ('objective = "min-total-clamp-force"', 'objective = "check-compliant"')
+CLAMP_FORCE = ("max_force = 2000.0", "max_force = 2000.0\nforce = 500.0")
+
+
+def test_check_compliant_reads_like_check_with_every_stiffness(tmp_path):
+    loaded = load_problem(_write(tmp_path, _with_stiffness(COMPLIANT, CLAMP_FORCE)))
+    assert loaded.problem.objective == "check-compliant"
+    assert set(loaded.stiffness) == {"jaw-fixed", "jaw-moving", "rest"}
+
+
+def test_check_compliant_names_the_contacts_without_stiffness(tmp_path):
+    text = _edited(VALID, COMPLIANT, ("max_force = 2000.0", OWN_STIFFNESS + "\nforce = 500.0"))
+    (issue,) = _issues(tmp_path, text)
+    assert issue.key_path == "objective"
+    assert issue.message.startswith(
+        "objective 'check-compliant' needs every contact's stiffness; missing for 'jaw-fixed', "
+        "'rest': add stiffness"
+    )
+
+
+def test_check_compliant_takes_the_active_forces_as_given(tmp_path):
+    text = _with_stiffness(COMPLIANT)
+    _assert_issue(_issues(tmp_path, text), "objective", "contact 'jaw-moving'.force is required")
+
+
+def test_an_invalid_default_stiffness_is_reported_once(tmp_path):
+    text = _edited(
+        VALID,
+        COMPLIANT,
+        CLAMP_FORCE,
+        (
+            'model = "ellipsoid"\n',
+            'model = "ellipsoid"\nstiffness = { normal = -1, tangential = 1 }\n',
+        ),
+    )
+    assert [issue.key_path for issue in _issues(tmp_path, text)] == ["defaults.stiffness.normal"]
+
+
+def test_an_objective_override_replaces_the_files_and_meets_its_demands(tmp_path):
+    check = ('objective = "min-total-clamp-force"', 'objective = "check"')
+    path = _write(tmp_path, _with_stiffness(check, CLAMP_FORCE))
+    assert load_problem(path, objective="check-compliant").problem.objective == "check-compliant"
+    assert load_problem(path).problem.objective == "check"
+    (issue,) = _issues(tmp_path, _edited(VALID, check, CLAMP_FORCE), objective="check-compliant")
+    assert issue.key_path == "objective"
+    assert issue.message.startswith("the objective override 'check-compliant' needs every")
+    with pytest.raises(InvalidArgumentError, match="objective"):
+        load_problem(path, objective="cheque")

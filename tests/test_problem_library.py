@@ -22,6 +22,7 @@ import pytest
 from fixplan import LimitSurface, pressure
 from fixplan.io.cli import EXIT_NOT_HELD, EXIT_OK, main
 from fixplan.io.problem_file import load_problem
+from fixplan.motion import hertz_sphere
 from fixplan.planner.contact_models import contact_model
 from fixplan.planner.planner import Planner
 from fixplan.planner.problem import MODEL_NAMES
@@ -43,6 +44,7 @@ OBJECTIVES = (
     "min-total-normal-force",
     "max-safety-factor",
     "check",
+    "check-compliant",
 )
 
 
@@ -86,6 +88,13 @@ EXPECTED = {
         objective_value=487.104755,
         safety_factor=1.0,
         critical_load="slot-feed-plus-x",
+    ),
+    "fixture-321-compliant": Expected(
+        status="optimal",
+        objective_value=4.103240,
+        safety_factor=4.103240,
+        critical_load="drill-outside-supports",
+        safety_factors={"slot-feed-plus-x": 4.462649, "face-mill-minus-x": math.inf},
     ),
     "hertz-pinch": Expected(status="optimal", objective_value=23.220633, safety_factor=1.0),
     "three-finger-grasp": Expected(status="optimal", objective_value=26.060177, safety_factor=1.0),
@@ -374,6 +383,26 @@ def test_fixture_clamp_total_is_the_least_that_holds_every_cut():
         result = Planner(check).solve()
         assert (result.safety_factor >= 1.0 - ON_LIMIT_ATOL) is held
         assert result.critical_load == "slot-feed-plus-x"
+
+
+@pytest.mark.parametrize(
+    ("contacts", "radius", "preload"),
+    [
+        (("rest-a", "rest-b", "rest-c", "side-pin-a", "side-pin-b", "end-pin"), 0.01, 300.0),
+        (("clamp-top",), 0.05, 1000.0),
+        (("clamp-side", "clamp-end"), 0.05, 400.0),
+    ],
+)
+def test_compliant_fixture_stiffnesses_are_the_hertz_contacts_its_comment_states(
+    contacts, radius, preload
+):
+    steel = {"young": 210e9, "poisson": 0.3, "young_flat": 210e9, "poisson_flat": 0.3}
+    expected = hertz_sphere(radius=radius, preload=preload, **steel)
+    stiffness = load_problem(PROBLEMS / "fixture-321-compliant.toml").stiffness
+    for name in contacts:
+        for key in ("normal", "tangential", "torsional"):
+            given, hertz = getattr(stiffness[name], key), getattr(expected, key)
+            assert given == pytest.approx(hertz, rel=5e-3), (name, key)
 
 
 # -- examples ------------------------------------------------------------------------------------

@@ -76,6 +76,7 @@ class _Names(Sequence):
 
 
 _MODEL_NAMES = _Names("fixplan.planner.problem", "MODEL_NAMES")
+_OBJECTIVES = _Names("fixplan.planner.problem", "OBJECTIVES")
 _DISK_PROFILES = _Names("fixplan.surface.pressure", "DISK_PROFILES")
 _FIT_MODELS = _Names("fixplan.motion.identify", "MODELS")
 
@@ -105,6 +106,16 @@ def _subcommand(commands, name: str, help_text: str, example: str, run):
     return parser
 
 
+def _objective_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--objective",
+        choices=_OBJECTIVES,
+        metavar="OBJECTIVE",
+        help="replace the file's objective (check-compliant: the check followed by the "
+        "compliant analysis): %(choices)s",
+    )
+
+
 def _build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="fixplan",
@@ -129,6 +140,7 @@ def _build_parser() -> argparse.ArgumentParser:
         "%(choices)s",
     )
     plan.add_argument("--solver", choices=("CLARABEL", "OSQP", "SCS"), help="conic/QP solver")
+    _objective_option(plan)
 
     check = _subcommand(
         commands, "check", "validate a problem file and report every problem in it",
@@ -136,6 +148,7 @@ def _build_parser() -> argparse.ArgumentParser:
         _run_check,
     )  # fmt: skip
     check.add_argument("file", type=Path, help="problem file (TOML)")
+    _objective_option(check)
 
     surface = _subcommand(
         commands, "surface", "the limit surface of one contact patch and every model's error",
@@ -247,6 +260,8 @@ def _number(value: float, unit: str = "") -> str:
 
 
 def _summary(problem_file, plan) -> str:
+    from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES
+
     problem = problem_file.problem
     lines = [
         f"problem    {problem_file.name} ({problem_file.kind}), {len(problem.contacts)} contacts, "
@@ -255,7 +270,7 @@ def _summary(problem_file, plan) -> str:
         f"status     {plan.status}",
     ]
     if plan.objective_value is not None:
-        unit = "" if plan.objective in ("max-safety-factor", "check") else "N"
+        unit = "" if plan.objective in FIXED_FORCE_OBJECTIVES else "N"
         if plan.objective == "min-squared-normal-force":
             unit = "N^2"
         lines.append(f"value      {_number(plan.objective_value, unit)}")
@@ -288,10 +303,31 @@ def _summary(problem_file, plan) -> str:
     return "\n".join(lines)
 
 
-def _load(file: Path, model: str | None = None):
+def _load(file: Path, model: str | None = None, objective: str | None = None):
     from fixplan.io.problem_file import load_problem
 
-    return load_problem(file, model=model)
+    return load_problem(file, model=model, objective=objective)
+
+
+def _compliant(problem_file, plan):
+    """The compliant analysis that objective check-compliant runs after the rigid check
+    (``None`` when the rigid check found no contact forces)."""
+    if plan.contact_wrenches is None:
+        return None
+    from fixplan.io.compliant_report import compliant_analysis
+
+    log.info("compliant analysis of %s", problem_file.path)
+    return compliant_analysis(problem_file, plan)
+
+
+def _compliant_outputs(plan, result) -> tuple[dict | None, list[str]]:
+    """The ``compliant`` object of ``--json`` and the compliant lines of the text output."""
+    if result is None:
+        return None, [f"compliant  not analysed: the rigid check ended {plan.status!r}"]
+    from fixplan.io.compliant_report import compliant_summary, describe_compliant
+
+    summary = compliant_summary(plan, result)
+    return summary, describe_compliant(summary)
 
 
 def _json(document: dict) -> str:
@@ -344,8 +380,9 @@ def _check_output_file(path: Path, option: str) -> None:
 
 def _run_plan(args: argparse.Namespace) -> tuple[int, str]:
     from fixplan.planner.planner import Planner
+    from fixplan.planner.problem import COMPLIANT_OBJECTIVE
 
-    problem_file = _load(args.file, args.model)
+    problem_file = _load(args.file, args.model, args.objective)
     if args.report is not None:
         _check_output_folder(args.report, "--report")
     try:
@@ -353,21 +390,27 @@ def _run_plan(args: argparse.Namespace) -> tuple[int, str]:
     except InvalidArgumentError:
         from fixplan.io.problem_file import check_problem
 
-        check_problem(args.file, model=args.model)  # names the file and the contact at fault
+        # Names the file and the contact at fault.
+        check_problem(args.file, model=args.model, objective=args.objective)
         raise
     log.info("solving %s (%d load cases)", args.file, len(problem_file.problem.loads))
     plan = planner.solve(progress=_Progress("solving", not args.quiet))
+    compliant = plan.objective == COMPLIANT_OBJECTIVE
+    result = _compliant(problem_file, plan) if compliant else None
     if args.report is not None:
         from fixplan.io.report import write_report
 
-        written = write_report(args.report, problem_file, plan, planner)
+        written = write_report(args.report, problem_file, plan, planner, compliant=result)
         log.info("wrote %d report files to %s", len(written), args.report)
+    summary, lines = _compliant_outputs(plan, result) if compliant else (None, [])
     if args.json:
         document = plan.as_dict()
         document["problem"] = {"name": problem_file.name, "file": str(problem_file.path),
                                "sha256": problem_file.sha256}  # fmt: skip
+        if compliant:
+            document["compliant"] = summary
         return _exit_code(plan), _json(document)
-    return _exit_code(plan), _summary(problem_file, plan)
+    return _exit_code(plan), "\n".join([_summary(problem_file, plan), *lines])
 
 
 # -- push ----------------------------------------------------------------------------------------
@@ -474,9 +517,14 @@ def _run_check(args: argparse.Namespace) -> tuple[int, str]:
 
     try:
         if file_kind(args.file) == PUSH_KIND:
+            if args.objective is not None:
+                raise InvalidArgumentError(
+                    f"--objective: {args.file} is a push file (no objective)"
+                )
             push_file = load_push(args.file)
             return EXIT_OK, _checked_push(args, push_file)
-        problem_file = check_problem(args.file)
+        problem_file = check_problem(args.file, objective=args.objective)
+        plan, result = _checked_compliant(args, problem_file)
     except ProblemFileError as exc:
         if not args.json:
             raise
@@ -485,6 +533,8 @@ def _run_check(args: argparse.Namespace) -> tuple[int, str]:
         document = {"file": str(args.file), "valid": False, "issues": issues}
         return EXIT_INVALID_INPUT, _json(document)
     problem = problem_file.problem
+    code = EXIT_OK if plan is None else _exit_code(plan)
+    summary, lines = (None, []) if plan is None else _compliant_outputs(plan, result)
     if args.json:
         document = {
             "file": str(args.file),
@@ -497,11 +547,30 @@ def _run_check(args: argparse.Namespace) -> tuple[int, str]:
             "loads": [load.name for load in problem.loads],
             "sha256": problem_file.sha256,
         }
-        return EXIT_OK, _json(document)
-    return EXIT_OK, (
+        if plan is not None:
+            document.update(status=plan.status, compliant=summary)
+        return code, _json(document)
+    valid = (
         f"{args.file}: valid — {problem_file.name} ({problem_file.kind}), objective "
         f"{problem.objective}, {len(problem.contacts)} contacts, {len(problem.loads)} load cases"
     )
+    if plan is not None:
+        valid += f"; rigid check {plan.status}, safety factor {_number(plan.safety_factor)}"
+    return code, "\n".join([valid, *lines])
+
+
+def _checked_compliant(args: argparse.Namespace, problem_file) -> tuple:
+    """``(plan, result)`` of the rigid check and the compliant analysis that objective
+    check-compliant asks ``check`` for; ``(None, None)`` for the other objectives."""
+    from fixplan.planner.problem import COMPLIANT_OBJECTIVE
+
+    if problem_file.problem.objective != COMPLIANT_OBJECTIVE:
+        return None, None
+    from fixplan.planner.planner import Planner
+
+    log.info("checking %s rigidly", args.file)
+    plan = Planner(problem_file.problem).solve(progress=_Progress("solving", not args.quiet))
+    return plan, _compliant(problem_file, plan)
 
 
 def _checked_push(args: argparse.Namespace, push_file) -> str:

@@ -1,5 +1,6 @@
-r"""Figures of a plan (contact layout, friction use per contact, safety factors, fixture surface)
-and of a pushed part's trajectory (a figure and an animated GIF).
+r"""Figures of a plan (contact layout, friction use per contact, safety factors, fixture surface,
+friction use in a compliant analysis) and of a pushed part's trajectory (a figure and an
+animated GIF).
 
 Every function computes its data first (plain numpy) and draws it second, on a
 :class:`matplotlib.figure.Figure` with the Agg canvas (never ``pyplot``, so no global state and
@@ -28,6 +29,7 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import FixplanError, InvalidArgumentError
+from fixplan.io.compliant_report import utilisation
 from fixplan.planner.plan import Plan
 from fixplan.planner.problem import Contact, Problem
 
@@ -36,6 +38,7 @@ if TYPE_CHECKING:  # pragma: no cover - typing only; matplotlib is imported when
     from matplotlib.figure import Figure
 
     from fixplan.models.base import FrictionModel
+    from fixplan.motion.compliance import ComplianceResult
     from fixplan.planner.contact_surface import ContactSetSurface
     from fixplan.surface.limit_surface import LimitSurface
 
@@ -472,6 +475,103 @@ def safety_figure(plan: Plan, *, ax: Axes | None = None) -> Figure:
     ax.set_ylabel("safety factor of the task load")
     ax.set_title("safety factor per load case (∞: not limited)", fontsize=11)
     return ax.figure
+
+
+# -- contact utilisation, rigid and compliant ------------------------------------------------
+
+#: Most panels per row of :func:`utilisation_figure` (one panel per load case).
+UTILISATION_COLUMNS = 3
+_RIGID_COLOR = "tab:blue"
+_COMPLIANT_COLOR = "tab:orange"
+
+
+@dataclass(frozen=True, slots=True)
+class _Utilisation:
+    cases: tuple[str, ...]
+    contacts: tuple[str, ...]
+    rigid: np.ndarray | None  # (cases, contacts); None: the plan has no utilisation
+    compliant: np.ndarray  # (cases, contacts), inf for a load without friction capacity
+    top: float  # axis top; infinite bars reach it
+    first: tuple[str | None, ...]  # the contact that slips first, per case
+
+
+def _utilisation_data(plan: Plan, result: ComplianceResult) -> _Utilisation:
+    table = utilisation(plan, result)
+    cases, contacts = result.load_names, result.contact_names
+    pairs = np.array([[table[c][k] for k in contacts] for c in cases], dtype=float)
+    rigid = None if plan.utilisation is None else pairs[:, :, 0]
+    finite = pairs[np.isfinite(pairs)]
+    top = 1.25 * max(1.2, float(finite.max())) if finite.size else 1.5
+    first = tuple(result.first_slip_contact[c] for c in cases)
+    return _Utilisation(cases, contacts, rigid, pairs[:, :, 1], top, first)
+
+
+def _utilisation_bars(ax, x, values, offset, color, label, top) -> None:
+    """Bars of ``values`` at ``x + offset``; infinite ones hatched up to ``top``."""
+    infinite = np.isinf(values)
+    bars = ax.bar(x + offset, np.where(infinite, top, values), width=0.38, color=color,
+                  edgecolor="black", linewidth=0.5, label=label)  # fmt: skip
+    for bar, endless in zip(bars, infinite, strict=True):
+        if endless:
+            bar.set_hatch("//")
+            bar.set_alpha(0.6)
+
+
+def utilisation_figure(
+    plan: Plan, result: ComplianceResult, *, axes: Sequence[Axes] | None = None
+) -> Figure:
+    """Friction used by every contact, rigid beside compliant, one panel per load case.
+
+    Grouped bars per contact: the rigid plan's utilisation at impending slip of the part (blue;
+    absent when the plan has none) and the compliant analysis's ``1 / s`` at the task load
+    (orange), with the line 1 where a contact slips; a load on a contact without friction
+    capacity (utilisation ``∞``) is a hatched bar up to the axis top. The label of the contact
+    that slips first as the task load grows is bold.
+
+    Parameters
+    ----------
+    plan : Plan
+        The rigid check whose forces ``result`` analysed.
+    result : ComplianceResult
+        Its compliant analysis (:func:`fixplan.motion.compliance.analyse`).
+    axes : sequence of Axes, optional
+        One per load case; default a new figure of up to :data:`UTILISATION_COLUMNS` panels
+        a row.
+
+    Returns
+    -------
+    Figure
+    """
+    data = _utilisation_data(plan, result)
+    if axes is None:
+        columns = min(UTILISATION_COLUMNS, len(data.cases))
+        rows = -(-len(data.cases) // columns)
+        width = max(4.0, 0.55 * len(data.contacts) + 1.5)
+        fig = _new_figure((width * columns, 3.4 * rows + 0.6))
+        axes = fig.subplots(rows, columns, squeeze=False).ravel()
+        for ax in axes[len(data.cases) :]:
+            ax.set_visible(False)
+    if len(axes) < len(data.cases):
+        raise InvalidArgumentError(f"axes must hold {len(data.cases)} Axes, got {len(axes)}")
+    x = np.arange(len(data.contacts))
+    for k, (ax, case) in enumerate(zip(axes, data.cases, strict=False)):
+        if data.rigid is not None:
+            _utilisation_bars(ax, x, data.rigid[k], -0.2, _RIGID_COLOR,
+                              "rigid, at impending slip", data.top)  # fmt: skip
+        _utilisation_bars(ax, x, data.compliant[k], 0.2, _COMPLIANT_COLOR,
+                          "compliant, at the task load", data.top)  # fmt: skip
+        ax.axhline(1.0, color="black", linestyle="--", linewidth=1.0)
+        ax.set_ylim(0.0, data.top)
+        ax.set_xticks(x, data.contacts, rotation=30, ha="right", fontsize=8)
+        for label, name in zip(ax.get_xticklabels(), data.contacts, strict=True):
+            if name == data.first[k]:
+                label.set_fontweight("bold")
+        ax.set_title(case, fontsize=10)
+        ax.set_ylabel("friction used")
+    axes[0].legend(loc="upper left", fontsize=7)
+    fig = axes[0].figure
+    fig.suptitle("friction used per contact (1: slips; bold: slips first)", fontsize=11)
+    return fig
 
 
 # -- fixture limit surface --------------------------------------------------------------------

@@ -11,9 +11,10 @@ SI throughout. The schema::
     objective = "min-total-clamp-force"   # required; one of fixplan.planner.problem.OBJECTIVES
     description = "..."                   # optional free text
 
-    [defaults]                            # optional; mu, model, facets, inscribed
+    [defaults]                            # optional; mu, model, facets, inscribed, stiffness
     mu = 0.3                              #   apply to every contact that does not set them
     model = "ellipsoid"                   #   (facets and inscribed only to pyramid models)
+    stiffness = { normal = 1e8, tangential = 5e7, torsional = 30.0 }
 
     [body]
     mass = 2.0                            # [kg], required
@@ -38,12 +39,21 @@ SI throughout. The schema::
     patch = { shape = "rectangle", length = 0.08, width = 0.03 }
     force = 150.0                         # fixed normal force of a clamp or finger [N]
     max_force = 2000.0                    # bound on a clamp's or finger's normal force [N]
+    stiffness = { normal = 6.2e7, tangential = 5.1e7 }   # springs in the contact frame:
+                                          # normal > 0 and tangential >= 0 [N/m], optional
+                                          # torsional >= 0 [N m/rad] (omitted: no moment)
 
     [[loads]]                             # at least one
     name = "face-mill-pass-1"             # required, unique
     force = [120.0, -40.0, -60.0]         # [N], required
     point = [0.03, 0.0, 0.04]             # [m], required
     torque = [0.0, 0.0, 1.5]              # [N m], optional
+
+A contact's **stiffness** (:class:`fixplan.motion.Stiffness`) is its own table, else the one of
+``[defaults]`` (a contact's table replaces it whole). Stiffnesses feed the compliant analysis
+(:func:`fixplan.motion.compliance.analyse`); the objective ``check-compliant`` (the rigid
+``check`` followed by that analysis) needs one for every contact. They are kept out of the
+:class:`~fixplan.planner.problem.Problem`, in :attr:`ProblemFile.stiffness`.
 
 A **fitted** contact (``model = "fitted"``) takes its friction set from a fit saved by
 :meth:`fixplan.motion.Fit.save` (``fixplan fit ... --json``), the file named by ``fit``, relative
@@ -100,14 +110,14 @@ from fixplan.io.toml_schema import (
     check_schema_version,
     check_unique_names,
     describe,
-    given,
     parse_toml,
     read_regular_file,
 )
-from fixplan.motion import Fit, FittedQuartic
+from fixplan.motion import Fit, FittedQuartic, Stiffness
 from fixplan.planner.contact_models import PLANNER_EXACT_ORDER, contact_model
 from fixplan.planner.problem import (
     AREA_MODEL_NAMES,
+    COMPLIANT_OBJECTIVE,
     MODEL_NAMES,
     OBJECTIVES,
     PASSIVE_ROLES,
@@ -126,8 +136,10 @@ from fixplan.tolerances import (
     MAX_LENGTH,
     MAX_MASS,
     MAX_MU,
+    MAX_STIFFNESS,
     MAX_TORQUE,
     MIN_MU,
+    MIN_STIFFNESS,
 )
 
 KINDS = ("fixture", "grasp")
@@ -167,8 +179,7 @@ _TOP_KEYS = (
     "contacts",
     "loads",
 )
-_DEFAULT_KEYS = ("mu", "model", "facets", "inscribed")
-_BODY_KEYS = ("mass", "center_of_mass", "gravity")
+_DEFAULT_KEYS = ("mu", "model", "facets", "inscribed", "stiffness")
 _CONTACT_KEYS = (
     "name",
     "role",
@@ -184,8 +195,8 @@ _CONTACT_KEYS = (
     "patch",
     "force",
     "max_force",
+    "stiffness",
 )
-_LOAD_KEYS = ("name", "force", "point", "torque")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -206,6 +217,9 @@ class ProblemFile:
         Hex SHA-256 digest of the file's bytes (identifies the exact input of a result).
     model_override : str or None
         The friction model that replaced every contact's model, if any.
+    stiffness : dict or None
+        :class:`~fixplan.motion.Stiffness` by contact name, for the contacts the file gives one
+        (their own or ``[defaults]``'); ``None`` when it gives none.
     """
 
     problem: Problem
@@ -214,9 +228,12 @@ class ProblemFile:
     path: Path
     sha256: str
     model_override: str | None = None
+    stiffness: dict[str, Stiffness] | None = None
 
 
-def load_problem(path: str | os.PathLike[str], *, model: str | None = None) -> ProblemFile:
+def load_problem(
+    path: str | os.PathLike[str], *, model: str | None = None, objective: str | None = None
+) -> ProblemFile:
     """Read and validate a TOML problem file (schema in the module docstring).
 
     Parameters
@@ -228,29 +245,34 @@ def load_problem(path: str | os.PathLike[str], *, model: str | None = None) -> P
         :data:`fixplan.planner.problem.MODEL_NAMES`). With an area model, contacts without a patch get
         its point version (:data:`POINT_VERSION`); ``facets`` and ``inscribed`` are dropped from
         contacts when the model is not a pyramid.
+    objective : str, optional
+        Objective that replaces the file's (one of :data:`fixplan.planner.problem.OBJECTIVES`);
+        its demands on the contacts (given forces, stiffnesses) are checked as the file's.
 
     Returns
     -------
     ProblemFile
-        The problem with the file's name, kind, path and digest.
+        The problem with the file's name, kind, path, digest and contact stiffnesses.
 
     Raises
     ------
     ProblemFileError
         The file cannot be read, is not TOML, or breaks the schema; lists every issue.
     InvalidArgumentError
-        ``model`` is not a model name.
+        ``model`` is not a model name or ``objective`` not an objective.
     """
     path = Path(path)
     if model is not None:
         model = validation.choice("model", model, MODEL_NAMES)
+    if objective is not None:
+        objective = validation.choice("objective", objective, OBJECTIVES)
     try:
         content = read_regular_file(path, MAX_FILE_BYTES)
     except InvalidValueError as exc:
         message = f"cannot read the file: {exc}"
         raise ProblemFileError(path, [Issue(key_path="", message=message)]) from None
     document = parse_toml(path, content)
-    reader = _Reader(folder=path.parent, model=model)
+    reader = _Reader(folder=path.parent, model=model, objective=objective)
     name, kind, problem = reader.document(document)
     if reader.issues or problem is None:
         raise ProblemFileError(path, reader.issues)
@@ -261,10 +283,13 @@ def load_problem(path: str | os.PathLike[str], *, model: str | None = None) -> P
         path=path,
         sha256=hashlib.sha256(content).hexdigest(),
         model_override=model,
+        stiffness=reader.stiffness or None,
     )
 
 
-def check_problem(path: str | os.PathLike[str], *, model: str | None = None) -> ProblemFile:
+def check_problem(
+    path: str | os.PathLike[str], *, model: str | None = None, objective: str | None = None
+) -> ProblemFile:
     """Read a problem file like :func:`load_problem` and also build every contact's friction
     model, so that every mistake of the input that planning would meet is found, without
     solving.
@@ -275,7 +300,7 @@ def check_problem(path: str | os.PathLike[str], *, model: str | None = None) -> 
         As :func:`load_problem`, or a contact's friction model cannot be built from its patch
         (reported at the contact's key path).
     """
-    problem_file = load_problem(path, model=model)
+    problem_file = load_problem(path, model=model, objective=objective)
     issues = []
     for index, contact in enumerate(problem_file.problem.contacts):
         try:
@@ -308,6 +333,23 @@ _POSITION = Array((3,), Number("", MAX_LENGTH, "m"))
 _FORCE_VECTOR = Array((3,), Number("", MAX_FORCE, "N"))
 _TORQUE_VECTOR = Array((3,), Number("", MAX_TORQUE, "N m"))
 _GRAVITY = Array((3,), Number("", MAX_ACCELERATION, "m/s^2"))
+_SOFTEST = "(springs that soft leave the compliant analysis too badly scaled to solve"
+_NORMAL_STIFFNESS = Number(
+    "> 0", MAX_STIFFNESS, "N/m", smallest=MIN_STIFFNESS, why_smallest=_SOFTEST + ")"
+)
+_TANGENTIAL_STIFFNESS = Number(
+    ">= 0", MAX_STIFFNESS, "N/m", smallest=MIN_STIFFNESS, why_smallest=_SOFTEST + "; or give 0)"
+)
+_TORSIONAL_STIFFNESS = Number(
+    ">= 0", MAX_STIFFNESS, "N m/rad", smallest=MIN_STIFFNESS, why_smallest=_SOFTEST + "; or give 0)"
+)
+_BODY_KINDS = {"mass": _MASS, "center_of_mass": _POSITION, "gravity": _GRAVITY}
+_LOAD_KINDS = {"name": _NAME, "force": _FORCE_VECTOR, "point": _POSITION, "torque": _TORQUE_VECTOR}
+_STIFFNESS_KINDS = {
+    "normal": _NORMAL_STIFFNESS,
+    "tangential": _TANGENTIAL_STIFFNESS,
+    "torsional": _TORSIONAL_STIFFNESS,
+}
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -321,10 +363,12 @@ class _Defaults:
 class _Reader:
     """Reads a parsed problem file, collecting issues; builds only what is valid."""
 
-    def __init__(self, *, folder: Path, model: str | None):
+    def __init__(self, *, folder: Path, model: str | None, objective: str | None):
         self.folder = folder
         self.model = model
+        self.objective = objective
         self.issues: list[Issue] = []
+        self.stiffness: dict[str, Stiffness] = {}  # by contact name
         self.fits: dict[tuple[str, int | None], object] = {}  # planner models of fits read
 
     def document(self, data: dict) -> tuple[str | None, str | None, Problem | None]:
@@ -337,7 +381,8 @@ class _Reader:
             top.report("kind", "a push file (kind = 'push'): run it with `fixplan push FILE`")
             return None, None, None
         kind = top.get("kind", Choice(KINDS), required=True)
-        objective = top.get("objective", Choice(OBJECTIVES), required=True)
+        objective = top.get("objective", Choice(OBJECTIVES), required=self.objective is None)
+        objective = self.objective or objective
         if "description" in data and not isinstance(data["description"], str):
             top.report("description", f"expected a string, got {describe(data['description'])}")
         defaults = self._defaults(top.table("defaults"))
@@ -345,6 +390,7 @@ class _Reader:
         contact_tables = top.tables("contacts")
         contacts = [self._contact(table, defaults) for table in contact_tables]
         check_unique_names(contact_tables, "contact")
+        self._stiffnesses(top, contact_tables, defaults, objective)
         load_tables = top.tables("loads")
         loads = [self._load(table) for table in load_tables]
         check_unique_names(load_tables, "load")
@@ -368,33 +414,42 @@ class _Reader:
         table.check_keys(_DEFAULT_KEYS)
         kinds = {"mu": _MU, "model": _MODEL, "facets": _FACETS, "inscribed": _BOOLEAN}
         values = {key: table.get(key, kind) for key, kind in kinds.items()}
+        values["stiffness"] = _stiffness(table)
         return _Defaults(
             values={key: value for key, value in values.items() if value is not None},
             keys=frozenset(table.data),
         )
 
+    def _stiffnesses(
+        self, top: Table, tables: list[Table], defaults: _Defaults, objective: str | None
+    ) -> None:
+        """Collect each contact's stiffness (its own, else ``[defaults]``'); report the contacts
+        without one if the objective needs them."""
+        missing = []
+        for table in tables:
+            own = "stiffness" in table.data
+            stiffness = _stiffness(table) if own else defaults.values.get("stiffness")
+            name = table.data.get("name")
+            if stiffness is not None and isinstance(name, str):
+                self.stiffness[name] = stiffness
+            elif not own and "stiffness" not in defaults.keys:
+                missing.append(repr(name) if isinstance(name, str) else table.path)
+        if objective == COMPLIANT_OBJECTIVE and missing:
+            source = "the objective override" if self.objective else "objective"
+            top.report(
+                "objective",
+                f"{source} {objective!r} needs every contact's stiffness; missing for "
+                f"{', '.join(missing)}: add stiffness = {{ normal = ..., tangential = ... }} "
+                "[N/m] to those [[contacts]] or to [defaults]",
+            )
+
     def _body(self, table: Table | None) -> Body | None:
         if table is None:
             return None
-        start = len(self.issues)
-        table.check_keys(_BODY_KEYS)
-        mass = table.get("mass", _MASS, required=True)
-        center = table.get("center_of_mass", _POSITION, required=True)
-        gravity = table.get("gravity", _GRAVITY)
-        if len(self.issues) > start:
-            return None
-        return build(table, Body, mass=mass, center_of_mass=center, **given(gravity=gravity))
+        return table.read(Body, _BODY_KINDS, required=("mass", "center_of_mass"))
 
     def _load(self, table: Table) -> Load | None:
-        start = len(self.issues)
-        table.check_keys(_LOAD_KEYS)
-        name = table.get("name", _NAME, required=True)
-        force = table.get("force", _FORCE_VECTOR, required=True)
-        point = table.get("point", _POSITION, required=True)
-        torque = table.get("torque", _TORQUE_VECTOR)
-        if len(self.issues) > start:
-            return None
-        return build(table, Load, name=name, force=force, point=point, **given(torque=torque))
+        return table.read(Load, _LOAD_KINDS, required=("name", "force", "point"))
 
     def _contact(self, table: Table, defaults: _Defaults) -> Contact | None:
         start = len(self.issues)
@@ -510,6 +565,15 @@ class _Reader:
             f"missing: {contact} needs a patch (area and pressure) for {source}; add one or use "
             "'point-cone' or 'point-pyramid'",
         )
+
+
+def _stiffness(table: Table) -> Stiffness | None:
+    """The ``stiffness`` table in ``table`` (a contact or ``[defaults]``); ``None`` if it is
+    missing or invalid (the issue reported)."""
+    springs = table.table("stiffness")
+    if springs is None:
+        return None
+    return springs.read(Stiffness, _STIFFNESS_KINDS, required=("normal", "tangential"))
 
 
 def _check_exact_size(table: Table, patch: pressure.PressureField) -> None:

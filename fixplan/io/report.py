@@ -5,10 +5,14 @@
 - ``report.md`` and ``report.html``: the same content (the HTML opens in a browser with its
   figures): a header of versions, model choices and the problem file's SHA-256, the status and
   objective, active forces, safety factors per load case, the impending motions in words, the
-  infeasibility certificate when there is one, and the figures;
+  infeasibility certificate when there is one, the compliant analysis when one is given (the
+  contacts' stiffnesses, per load case the first contact to slip, the contacts lifted off and
+  the part's displacement, and every contact's friction use, rigid beside compliant), and the
+  figures;
 - ``plan.json``: :meth:`Plan.as_dict` with sorted keys;
 - PNG figures (:mod:`fixplan.io.figures`): ``layout.png``, ``safety-factors.png``,
-  ``contact-NN-NAME.png`` per loaded area contact and ``contact-set.png``.
+  ``contact-NN-NAME.png`` per loaded area contact, ``contact-set.png`` and, with a compliant
+  analysis, ``compliant-utilisation.png``.
 
 The report is built once as a list of blocks (headings, paragraphs, tables, lists, images) and
 rendered to both formats from them. Nothing in it depends on the time or the machine's paths,
@@ -32,6 +36,7 @@ import numpy as np
 import fixplan
 from fixplan.errors import FixplanError, InvalidArgumentError
 from fixplan.io import figures
+from fixplan.io.compliant_report import compliant_summary, first_slip_text, millionths
 from fixplan.io.problem_file import ProblemFile
 from fixplan.io.report_document import (
     Block,
@@ -46,6 +51,7 @@ from fixplan.io.report_document import (
     inline,
     staged_folder,
 )
+from fixplan.motion.compliance import ComplianceResult
 from fixplan.planner.contact_surface import COMPONENTS, ContactSetSurface
 from fixplan.planner.plan import Plan
 from fixplan.planner.planner import Planner
@@ -65,6 +71,8 @@ SLUG_LENGTH = 40
 #: Equilibrium residuals below this are printed as ``below RESIDUAL_FLOOR`` (their digits are
 #: rounding noise that differs between machines).
 RESIDUAL_FLOOR = 1e-12
+#: The figure of a compliant analysis (:func:`fixplan.io.figures.utilisation_figure`).
+UTILISATION_FIGURE = "compliant-utilisation.png"
 
 _SOLVER_PACKAGES = {"CLARABEL": "clarabel", "OSQP": "osqp", "SCS": "scs"}
 
@@ -390,6 +398,94 @@ def _wrench_table(plan: Plan, j: int, length_scale: float) -> list[Block]:
     ]
 
 
+def _micro(values) -> str:
+    """Three components [m or rad] in millionths (µm, µrad)."""
+    return ", ".join(_num(v, 4) for v in millionths(values))
+
+
+def _cells(*values: str) -> tuple:
+    return tuple(inline(value) for value in values)
+
+
+def _stiffness_rows(problem_file: ProblemFile) -> tuple:
+    """Each contact's springs [N/m, N/m, N m/rad]."""
+    return tuple(
+        _cells(
+            name,
+            _num(k.normal),
+            _num(k.tangential),
+            "none" if k.torsional is None else _num(k.torsional),
+        )
+        for name, k in (problem_file.stiffness or {}).items()
+    )
+
+
+def _outcome_rows(summary: dict) -> tuple:
+    """Each load case's rigid safety factor, first slip, lifted contacts and displacement."""
+    return tuple(
+        _cells(
+            case, _num(summary["rigid_safety_factors"][case]), first_slip_text(summary, case),
+            ", ".join(summary["lifted"][case]) or "none", _micro(moved[:3]), _micro(moved[3:]),
+        )
+        for case, moved in summary["displacement"].items()
+    )  # fmt: skip
+
+
+def _use_rows(summary: dict) -> tuple:
+    """Each contact's compliant normal force and friction use, rigid and compliant, per case."""
+    return tuple(
+        _cells(
+            case, contact, _num(summary["wrenches"][case][contact][0]), _num(use["rigid"], 3),
+            _num(use["compliant"], 3),
+        )
+        for case, row in summary["utilisation"].items()
+        for contact, use in row.items()
+    )  # fmt: skip
+
+
+_COMPLIANT_TEXT = (
+    "The contacts as linear springs in their own frames (stiffnesses below) on the rigid part "
+    "(fixplan.motion.compliance): the clamps and fingers press with the given forces, then "
+    "gravity and the task load are applied; every contact's wrench, its own safety factor and "
+    "the part's displacement follow. The first slip is the smallest multiple of the task load "
+    "at which a contact reaches its friction set; the displacement (x, y, z) and rotation (about "
+    "x, y, z) are the part's at the task load, about its centre of mass."
+)
+_USE_TEXT = (
+    "Friction used: the fraction of a contact's friction set its load uses (1 on the limit). "
+    "Rigid: the plan's, at impending slip of the whole part (the task load times its rigid "
+    "safety factor). Compliant: 1 / the contact's own safety factor at the task load; fn is its "
+    "compliant normal force."
+)
+
+
+def _compliant_section(problem_file, plan, result, writer) -> list[Block]:
+    """The compliant analysis: the stiffnesses, each load case's outcome, every contact's
+    friction use (rigid and compliant) and its figure."""
+    summary = compliant_summary(plan, result)
+    writer.figure(UTILISATION_FIGURE, lambda: figures.utilisation_figure(plan, result))
+    springs = _stiffness_rows(problem_file)
+    outcome = ("load case", "rigid safety factor", "first slip", "lifted off",
+               "displacement [µm]", "rotation [µrad]")  # fmt: skip
+    uses = ("load case", "contact", "fn [N]", "friction used, rigid", "friction used, compliant")
+    caption = (
+        "Friction used by every contact in every load case: rigid (blue) beside compliant "
+        "(orange); the dashed line is where a contact slips."
+    )
+    stiffness = ("contact", "normal [N/m]", "tangential [N/m]", "torsional [N m/rad]")
+    return [
+        Heading(2, inline("Compliant analysis")),
+        Paragraph(inline(_COMPLIANT_TEXT)),
+        *([Table(stiffness, springs)] if springs else []),
+        Table(outcome, _outcome_rows(summary)),
+        Paragraph(inline(_USE_TEXT)),
+        Table(uses, _use_rows(summary)),
+        Image(
+            UTILISATION_FIGURE, "friction used per contact, rigid and compliant", inline(caption)
+        ),
+    ]
+
+
 def _figure_case(plan: Plan) -> tuple[str, str | None]:
     """The load case the figures show, and a note when it is not the critical one."""
     if plan.critical_load is not None:
@@ -408,6 +504,7 @@ def write_report(
     planner: Planner,
     *,
     sliding_subspace: Sequence[str] | None = None,
+    compliant: ComplianceResult | None = None,
 ) -> list[Path]:
     """Write the report of ``plan`` into ``directory`` (see the module docstring).
 
@@ -430,6 +527,9 @@ def write_report(
     sliding_subspace : sequence of str, optional
         Wrench components of the contact-set surface figure; default
         :func:`default_sliding_subspace`.
+    compliant : ComplianceResult, optional
+        The compliant analysis of ``plan``'s forces (:func:`fixplan.motion.compliance.analyse`)
+        with ``problem_file.stiffness``; adds the "Compliant analysis" section.
 
     Returns
     -------
@@ -455,11 +555,12 @@ def write_report(
     directory = Path(directory)
     with staged_folder(directory) as staging:
         writer = Writer(staging)
-        _write_files(writer, problem_file, plan, planner, subspace)
+        _write_files(writer, problem_file, plan, planner, subspace, compliant)
     return [directory / path.name for path in writer.written]
 
 
-def _write_files(writer: Writer, problem_file: ProblemFile, plan: Plan, planner, subspace):
+def _write_files(writer: Writer, problem_file: ProblemFile, plan: Plan, planner, subspace,
+                 compliant):  # fmt: skip
     """Write every file of the report (see the module docstring) with ``writer``."""
     problem = planner.problem
     document = json.dumps(plan.as_dict(), indent=2, sort_keys=True)
@@ -469,6 +570,8 @@ def _write_files(writer: Writer, problem_file: ProblemFile, plan: Plan, planner,
     blocks = _header(problem_file, plan, planner, subspace) + _result(plan, problem)
     if plan.contact_wrenches is not None:
         blocks += _wrench_table(plan, plan.load_names.index(load), planner.length_scale)
+    if compliant is not None:
+        blocks += _compliant_section(problem_file, plan, compliant, writer)
     blocks.append(Heading(2, inline("Figures")))
     if case_note:
         blocks.append(Paragraph(inline(case_note)))

@@ -367,6 +367,17 @@ class Table:
             self.report(key, str(exc))
             return None
 
+    def read(self, constructor: Callable, kinds: dict[str, Kind], *, required: Sequence[str]):
+        """``constructor(**values)`` of this table's keys, each converted by its kind in
+        ``kinds`` (the keys allowed); ``None`` if a key is unknown, invalid or ``required`` and
+        missing, or the constructor rejects the values (every issue reported)."""
+        start = len(self.issues)
+        self.check_keys(tuple(kinds))
+        values = {key: self.get(key, kind, required=key in required) for key, kind in kinds.items()}
+        if len(self.issues) > start:
+            return None
+        return build(self, constructor, **given(**values))
+
     def direction(self, key: str, *, required: bool = False) -> list[float] | None:
         """A nonzero 3-vector at ``key``."""
         vector = self.get(key, DIRECTION, required=required)

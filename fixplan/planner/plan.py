@@ -25,7 +25,7 @@ class Plan:
         The objective solved.
     objective_value : float or None
         Total or largest force [N] for the force objectives; the smallest safety factor over
-        the load cases for ``"max-safety-factor"`` and ``"check"``.
+        the load cases for ``"max-safety-factor"``, ``"check"`` and ``"check-compliant"``.
     load_names, contact_names : tuple of str
         Order of the load cases and contacts in the arrays below.
     normal_forces : array (contacts, loads)

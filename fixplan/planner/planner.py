@@ -32,7 +32,13 @@ from fixplan.planner.certificate import certificate
 from fixplan.planner.contact_models import contact_model
 from fixplan.planner.objectives import objective_value
 from fixplan.planner.plan import Plan
-from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, PASSIVE_ROLES, Load, Problem
+from fixplan.planner.problem import (
+    FIXED_FORCE_OBJECTIVES,
+    PASSIVE_ROLES,
+    SOLVED_AS,
+    Load,
+    Problem,
+)
 from fixplan.planner.runner import SOLVERS, Runner
 from fixplan.planner.squeeze import squeezing, unload_squeezes
 from fixplan.planner.stacking import REFINE, ContactLayout
@@ -98,7 +104,7 @@ class Planner:
                 f"loads must be {len(self.problem.loads)} Load objects, one per load case"
             )
         start = time.perf_counter()
-        objective = self.problem.objective
+        objective = SOLVED_AS.get(self.problem.objective, self.problem.objective)
         names = tuple(x.name for x in loads)
         wrenches = np.column_stack([load.wrench for load in loads])
         given = {i: c.force for i, c in enumerate(self.problem.contacts) if c.force is not None}

@@ -39,9 +39,16 @@ OBJECTIVES = (
     "min-squared-normal-force",
     "max-safety-factor",
     "check",
+    "check-compliant",
 )
 #: Objectives that take the active forces as given.
-FIXED_FORCE_OBJECTIVES = ("max-safety-factor", "check")
+FIXED_FORCE_OBJECTIVES = ("max-safety-factor", "check", "check-compliant")
+#: The objective whose rigid check is followed by the compliant analysis of the layer above
+#: (:func:`fixplan.motion.compliance.analyse`), which its callers run; it needs every
+#: contact's stiffness.
+COMPLIANT_OBJECTIVE = "check-compliant"
+#: The objective the planner solves for each objective it does not solve as itself.
+SOLVED_AS = {COMPLIANT_OBJECTIVE: "check"}
 
 #: Facets of a pyramid model when none are given (the four of the paper's eq. 11).
 DEFAULT_FACETS = 4
