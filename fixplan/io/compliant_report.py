@@ -83,8 +83,11 @@ def compliant_summary(plan: Plan, result: ComplianceResult) -> dict:
         },
         "displacement": {c: result.displacement[c].tolist() for c in cases},
         "lifted": {c: list(result.lifted[c]) for c in cases},
+        "sliding": {c: list(result.sliding[c]) for c in cases},
         "first_slip": dict(result.first_slip),
         "first_slip_contact": dict(result.first_slip_contact),
+        "collapse": dict(result.collapse),
+        "held": dict(result.held),
         "rigid_safety_factors": {c: plan.safety_factors.get(c) for c in cases},
         "utilisation": {
             c: {k: {"rigid": r, "compliant": u} for k, (r, u) in row.items()}
@@ -117,7 +120,10 @@ def first_slip_text(summary: dict, case: str) -> str:
         return "no contact slips (at any multiple searched)"
     if contact is None:
         return f"the part leaves its contacts at {_value(multiple)} × the task load"
-    return f"{contact!r} slips first, at {_value(multiple)} × the task load"
+    return (
+        f"{contact!r} slips first, at {_value(multiple)} × the task load; the part moves at "
+        f"{_value(summary['collapse'][case])} ×"
+    )
 
 
 def describe_compliant(summary: dict) -> list[str]:
@@ -134,6 +140,12 @@ def describe_compliant(summary: dict) -> list[str]:
             f"    displacement {_vector(displacement[:3])} µm, rotation "
             f"{_vector(displacement[3:])} µrad",
             f"    lifted off   {', '.join(summary['lifted'][case]) or 'none'}",
+            f"    sliding      {', '.join(summary['sliding'][case]) or 'none'}"
+            + (
+                ""
+                if summary["held"][case]
+                else " (the part moves before the task load: state at the collapse multiple)"
+            ),
             f"    {'contact':24s} {'rigid':>10s} {'compliant':>10s}",
         ]
         lines += [

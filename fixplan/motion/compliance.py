@@ -140,9 +140,12 @@ class ComplianceResult:
         body lifts off).
     collapse : dict
         Per case: the multiple of the task load at which the part as a whole moves (its
-        contacts can no longer balance the load); ``inf`` if it does not up to ``max_multiple``.
+        contacts can no longer balance the load); ``inf`` if it does not up to ``max_multiple``;
+        NaN if the increments did not bracket it within their budget (slow convergence of the
+        friction bounds where many contacts slide; see :mod:`fixplan.motion.load_ramp`).
     held : dict
-        Per case: whether the part stays put under the task load (``collapse >= 1``).
+        Per case: whether the part stays put under the task load (``collapse >= 1``, or the task
+        load was reached when ``collapse`` is NaN).
     """
 
     load_names: tuple[str, ...]
@@ -229,7 +232,7 @@ def analyse(
         fields["first_slip"][case] = first
         fields["first_slip_contact"][case] = None if who is None else names[who]
         fields["collapse"][case] = collapse
-        fields["held"][case] = bool(collapse >= 1.0)
+        fields["held"][case] = bool(collapse >= 1.0 or (np.isnan(collapse) and state.multiple >= 1))
         _record(fields, case, names, contacts, models, state, delta0)
     return ComplianceResult(
         load_names=tuple(load.name for load in problem.loads), contact_names=names, **fields

@@ -59,6 +59,10 @@ FIXED_POINT_RTOL = 1e-9
 #: Most fixed-point iterations of one increment before it counts as failed (and is halved).
 MAX_FIXED_POINT_ITERATIONS = 30
 
+#: Most increments (tried, including halved ones) per requested step; beyond them the collapse
+#: multiple is reported as not found (NaN).
+MAX_INCREMENTS_PER_STEP = 10
+
 #: The collapse multiple is bracketed to this relative accuracy.
 COLLAPSE_RTOL = 1e-7
 
@@ -230,11 +234,14 @@ class LoadRamp:
 
     def follow(self, start: State, steps: int, limit: float) -> tuple[float, State, State | None]:
         """Raise the load from ``start`` (the first slip) in increments: the collapse multiple
-        (``inf`` if none up to ``limit``), the last state reached and the state at the task load
-        (``None`` if the body moves before it)."""
+        (``inf`` if none up to ``limit``; NaN if it is not bracketed within the budget of
+        increments), the last state reached and the state at the task load (``None`` if the body
+        moves before it or it was not reached)."""
         base = max(start.multiple, 1.0) / steps
         step, state, at_task = base, start, (start if start.multiple == 1.0 else None)
-        while state.multiple < limit:
+        for _ in range(MAX_INCREMENTS_PER_STEP * steps):
+            if state.multiple >= limit:
+                return np.inf, state, at_task
             multiple = min(state.multiple + step, limit)
             if state.multiple < 1.0 < multiple:
                 multiple = 1.0
@@ -249,7 +256,7 @@ class LoadRamp:
             if state.multiple == 1.0:
                 at_task = state
             step = 2.0 * step if state.multiple >= 1.0 else min(2.0 * step, base)
-        return np.inf, state, at_task
+        return np.nan, state, at_task
 
 
 def _slip_root(model, forces, slope, start, end) -> float | None:
