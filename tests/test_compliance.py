@@ -204,11 +204,20 @@ def test_stiffness_rejects_values_out_of_range(arguments):
         Stiffness(**arguments)
 
 
-def test_a_load_that_pulls_the_part_off_its_supports_is_an_error():
+def test_a_load_that_pulls_the_part_off_its_supports_moves_it_at_once():
     contacts = [_point(n, "support", [x, 0, 0], [0, 0, 1]) for n, x in (("l", -0.1), ("r", 0.1))]
     lift = Load(name="lift", force=np.array([0, 0, 5.0]), point=np.zeros(3))
     problem = _problem(contacts, [lift])
-    with pytest.raises(ComplianceError, match=r"'lift'.*leaves its contacts"):
+    result = analyse(problem, None, stiffness=Stiffness(normal=1e6, tangential=1e5))
+    assert result.collapse["lift"] == result.first_slip["lift"] == 0.0
+    assert result.first_slip_contact["lift"] is None and not result.held["lift"]
+
+
+def test_a_clamp_that_pushes_the_part_off_its_supports_is_an_error():
+    support = _point("s", "support", [0, 0, 0], [0, 0, 1])
+    clamp = _point("c", "clamp", [0, 0, -0.01], [0, 0, 1], mu=0.0, force=20.0)
+    problem = _problem([support, clamp], [Load(name="none", force=np.zeros(3), point=np.zeros(3))])
+    with pytest.raises(ComplianceError, match=r"'none'.*balance"):
         analyse(problem, None, stiffness=Stiffness(normal=1e6, tangential=1e5))
 
 

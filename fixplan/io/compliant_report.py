@@ -119,7 +119,10 @@ def first_slip_text(summary: dict, case: str) -> str:
     if math.isinf(multiple):
         return "no contact slips (at any multiple searched)"
     if contact is None:
-        return f"the part leaves its contacts at {_value(multiple)} × the task load"
+        return (
+            f"the part moves at {_value(multiple)} × the task load (it leaves its contacts or "
+            "turns where no spring holds it)"
+        )
     return (
         f"{contact!r} slips first, at {_value(multiple)} × the task load; the part moves at "
         f"{_value(summary['collapse'][case])} ×"

@@ -134,7 +134,8 @@ class ComplianceResult:
     first_slip : dict
         Per case: the smallest multiple of the task load (gravity kept) at which some contact's
         wrench reaches its friction set (0 if one is there without the task load; ``inf`` if
-        none is up to ``max_multiple``), or at which the body leaves all its contacts.
+        none is up to ``max_multiple``), or at which the body leaves its contacts or moves where
+        no spring holds it (a moment about a grasp axis without torsional springs: at once).
     first_slip_contact : dict
         Per case: the contact that slips first (``None`` when ``first_slip`` is infinite or the
         body lifts off).

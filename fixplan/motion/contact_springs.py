@@ -244,13 +244,21 @@ class SpringSystem:
         forces = np.where(touching[:, None], r - k * motion, 0.0)
         return forces, delta, motion
 
+    def balances(self, forces, wrench) -> bool:
+        """Whether contact forces ``(m, 4)`` balance ``wrench`` to :data:`KKT_RTOL`."""
+        return self._imbalance(forces, wrench) <= KKT_RTOL
+
+    def _imbalance(self, forces, wrench) -> float:
+        """Largest equilibrium residual, in units of the force scale (moments over length)."""
+        residual = (np.einsum("iap,ip->a", self.bases, forces) + wrench) / self.qp.rows
+        return float(np.abs(residual).max())
+
     def _polish(self, reference, springs, wrench, touching, case):
         """:meth:`linear`, checked against the QP's optimality conditions."""
         forces, delta, motion = self.linear(reference, springs, wrench, touching)
-        residual = (np.einsum("iap,ip->a", self.bases, forces) + wrench) / self.qp.rows
         would_be = reference[:, 0] - springs[:, 0] * motion[:, 0]
         worst = max(
-            float(np.abs(residual).max()),
+            self._imbalance(forces, wrench),
             float(-forces[touching, 0].min(initial=0.0)) / self.qp.scale,
             float(would_be[~touching].max(initial=0.0)) / self.qp.scale,
         )

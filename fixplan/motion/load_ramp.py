@@ -131,7 +131,7 @@ class LoadRamp:
     def first_slip(self, limit: float) -> tuple[float, int | None, State | None]:
         """Smallest multiple in ``[0, limit]`` at which a sticking contact reaches its friction
         set (with that contact and the state there), or at which the body leaves its contacts
-        (with ``None`` and the state there); ``(inf, None, None)`` when neither happens.
+        or moves where no spring holds it (with ``None`` and the state there); ``(inf, None, None)`` when neither happens.
         Followed piece by piece: at the end of a piece the contact whose normal force reached 0
         lifts (or the one whose gap closed touches). Raises :class:`NoEquilibriumError` when
         the contacts cannot balance the weight."""
@@ -143,6 +143,8 @@ class LoadRamp:
         for _ in range(4 * len(self.models) + 4):
             zero = np.zeros_like(self.reference)
             slope, _, motion = self.system.linear(zero, springs, self.task, touching)
+            if not self.system.balances(slope, self.task):
+                return start, None, state  # no spring resists part of the task load
             # The piece ends where a touching contact's normal force falls to 0 or a lifted
             # one's would-be force rises to 0.
             rate = np.where(touching, -slope[:, 0], -self.system.springs[:, 0] * motion[:, 0])
