@@ -70,6 +70,8 @@ def main() -> None:
         springs = stiffness(problem)
         result = compliance.analyse(problem, None, stiffness=springs)
         slips = sum(result.first_slip[c] < 1.0 for c in result.load_names)
+        unbracketed = sum(np.isnan(result.collapse[c]) for c in result.load_names)
+        seated = sum(result.seated.values())
         compliant = median_seconds(
             lambda p=problem, s=springs: compliance.analyse(p, None, stiffness=s)
         )
@@ -78,8 +80,8 @@ def main() -> None:
         print(
             f"clamp forces x{multiple:g}: compliant {1 / compliant:6.2f} analyses/s "
             f"({compliant / cases * 1e3:6.1f} ms per case; {slips} of {cases} cases slip below "
-            f"the task load), rigid check {1 / rigid:6.2f}/s; compliant/rigid time "
-            f"{compliant / rigid:5.1f}x"
+            f"the task load, {seated} seated, {unbracketed} collapse not bracketed), rigid check "
+            f"{1 / rigid:6.2f}/s; compliant/rigid time {compliant / rigid:5.1f}x"
         )
 
 

@@ -76,6 +76,8 @@ def test_the_compliant_section_prints_the_values_of_analyse(tmp_path, capsys, co
         first = re.search(r"'(\w+)' slips first, at (\S+) × the task load", block)
         assert first.group(1) == result.first_slip_contact[case]
         assert float(first.group(2)) == pytest.approx(result.first_slip[case], rel=PRINTED_RTOL)
+        seating = "seated" if result.seated[case] else "stuck"
+        assert re.search(rf"clamping\s+{seating} \(", block)
         moved = re.search(r"displacement \((.*)\) µm, rotation \((.*)\) µrad", block)
         printed = _numbers(moved.group(1)) + _numbers(moved.group(2))
         scale = np.abs(result.displacement[case]).reshape(2, 3).max(axis=1).repeat(3)
@@ -156,6 +158,7 @@ def test_the_json_compliant_object_holds_the_values_of_analyse(tmp_path, capsys,
         _assert_same(compliant["first_slip"][case], result.first_slip[case])
         _assert_same(compliant["rigid_safety_factors"][case], plan.safety_factors[case])
         assert compliant["lifted"][case] == list(result.lifted[case])
+        assert compliant["seated"][case] is result.seated[case]
         assert compliant["first_slip_contact"][case] == result.first_slip_contact[case]
 
 

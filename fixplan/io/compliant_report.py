@@ -82,6 +82,7 @@ def compliant_summary(plan: Plan, result: ComplianceResult) -> dict:
             c: {k: v.tolist() for k, v in result.slip_directions[c].items()} for c in cases
         },
         "displacement": {c: result.displacement[c].tolist() for c in cases},
+        "seated": dict(result.seated),
         "lifted": {c: list(result.lifted[c]) for c in cases},
         "sliding": {c: list(result.sliding[c]) for c in cases},
         "first_slip": dict(result.first_slip),
@@ -142,6 +143,13 @@ def describe_compliant(summary: dict) -> list[str]:
             f"  load case {case!r}: rigid safety factor {rigid}; {first_slip_text(summary, case)}",
             f"    displacement {_vector(displacement[:3])} µm, rotation "
             f"{_vector(displacement[3:])} µrad",
+            "    clamping     "
+            + (
+                "seated (friction springs start unloaded)"
+                if summary["seated"][case]
+                else "stuck (no frictionless seating exists: friction springs take their share "
+                "of the preloads)"
+            ),
             f"    lifted off   {', '.join(summary['lifted'][case]) or 'none'}",
             f"    sliding      {', '.join(summary['sliding'][case]) or 'none'}"
             + (

@@ -25,13 +25,26 @@ force or no moment.
 Loading happens in two steps.
 
 1. **Clamping.** The clamps and fingers push with their preloads (given forces, normal only);
-   the locators and supports are springs that start just touching. Their reactions balance the
-   preloads (gravity is not part of this step, so that a grasp without supports, whose preloads
-   balance each other, is well posed).
+   the locators and supports are springs that start just touching. How friction builds up while
+   the part is clamped depends on the clamping sequence, which the problem does not give; two
+   models are offered (``seating``):
+
+   - ``"seated"`` (the default): the part seats on its locators, as when it is tapped or
+     vibrated into place, so their friction springs start unloaded: the locators' normal springs
+     alone balance the preloads and the weight (an exact frictionless equilibrium), and the
+     friction springs of every contact start from that state. Where no such equilibrium exists
+     (a grasp that holds the weight by friction, a part that would slide off) the ``"stuck"``
+     model is used for that case, and ``seated[case]`` is false.
+   - ``"stuck"``: every spring starts just touching and the locators' friction springs take
+     their share of the preloads and the weight, as if the part were clamped with no slip at
+     all (where the springs cannot carry the weight, as in a grasp without supports whose
+     preloads balance each other, the weight is applied in the next step). A contact whose
+     share exceeds its friction slides (one increment of the load ramp below), and is then at
+     its limit: the first slip is at 0.
 2. **Task.** Every contact becomes a spring about its clamped state, except that a clamp's
    normal force stays at its preload (a force-controlled clamp, as in the planner; its friction
    is still a sticking spring) while a finger's normal spring acts about its preload. Gravity
-   plus ``λ`` times the task load are applied and ``λ`` rises from 0 (:mod:`fixplan.motion.
+   (which a seated part already carries) plus ``λ`` times the task load are applied and ``λ`` rises from 0 (:mod:`fixplan.motion.
    load_ramp`): exactly up to the first contact that slips, then in increments in which sliding
    contacts carry their limit load, up to the multiple at which the part as a whole moves.
 
@@ -51,6 +64,8 @@ from fixplan.errors import InvalidArgumentError
 from fixplan.motion.contact_springs import (
     ComplianceError,
     ContactQP,
+    InaccurateStepError,
+    NoEquilibriumError,
     SpringSystem,
     WrongContactSetError,
 )
@@ -65,6 +80,9 @@ DEFAULT_STEPS = 20
 
 #: A contact whose safety factor is below ``1 + SLIDING_RTOL`` slides.
 SLIDING_RTOL = 1e-6
+
+#: How friction builds up during clamping (see the module doc).
+SEATINGS = ("seated", "stuck")
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -128,7 +146,11 @@ class ComplianceResult:
         centre of mass, from the just-touching position (clamping included). Directions in which
         no spring holds the body (a singular stiffness) get 0.
     clamped_displacement : dict
-        Per case: the same after clamping, before gravity and the task load.
+        Per case: the same after clamping, before the task load (and before gravity where the
+        clamped springs could not carry it).
+    seated : dict
+        Per case: whether the part was seated (``seating="seated"`` and a frictionless
+        equilibrium of the clamping exists) rather than clamped stuck.
     lifted, sliding : dict
         Per case: names of the contacts that carry no force, and of those that slide.
     first_slip : dict
@@ -142,8 +164,8 @@ class ComplianceResult:
     collapse : dict
         Per case: the multiple of the task load at which the part as a whole moves (its
         contacts can no longer balance the load); ``inf`` if it does not up to ``max_multiple``;
-        NaN if the increments did not bracket it within their budget (slow convergence of the
-        friction bounds where many contacts slide; see :mod:`fixplan.motion.load_ramp`).
+        NaN if the increments did not bracket it within their budget (the friction bounds'
+        fixed point failing along a stretch of the path; see :mod:`fixplan.motion.load_ramp`).
     held : dict
         Per case: whether the part stays put under the task load (``collapse >= 1``, or the task
         load was reached when ``collapse`` is NaN).
@@ -156,6 +178,7 @@ class ComplianceResult:
     slip_directions: dict
     displacement: dict
     clamped_displacement: dict
+    seated: dict
     lifted: dict
     sliding: dict
     first_slip: dict
@@ -171,6 +194,7 @@ def analyse(
     stiffness: Stiffness | Mapping[str, Stiffness],
     steps: int = DEFAULT_STEPS,
     max_multiple: float = MAX_SAFETY_FACTOR,
+    seating: str = "seated",
 ) -> ComplianceResult:
     """Analyse every load case of ``problem`` with compliant contacts (see the module doc).
 
@@ -189,6 +213,8 @@ def analyse(
         contacts' path more closely; see :mod:`fixplan.motion.load_ramp`).
     max_multiple : float, keyword-only
         Largest multiple of the task load searched for the first slip and the collapse.
+    seating : {"seated", "stuck"}, keyword-only
+        How friction builds up during clamping (see the module doc).
 
     Raises
     ------
@@ -203,6 +229,8 @@ def analyse(
     )
     steps = validation.positive_int("steps", steps)
     limit = validation.positive_scalar("max_multiple", max_multiple)
+    if seating not in SEATINGS:
+        raise ComplianceError(f"seating must be one of {', '.join(SEATINGS)}, got {seating!r}")
     centre = problem.body.center_of_mass
     bases = np.stack([_about(c.wrench_basis(), centre) for c in contacts])
     passive = np.array([c.role in PASSIVE_ROLES for c in contacts])
@@ -215,13 +243,21 @@ def analyse(
     # Clamping: the active contacts push with their preloads (an external wrench) and carry
     # nothing else. Task: a clamp's normal force stays at its preload (force-controlled).
     clamping = _system(bases, np.where(passive[:, None], springs, 0.0), models, scale)
+    seat = None
+    if seating == "seated":  # the locators' normal springs only: friction held at 0
+        seat = _system(
+            bases, np.where(passive[:, None] & (np.arange(4) == 0), springs, 0.0), models, scale
+        )
     loading = _system(
         bases, np.where(clamp[:, None] & (np.arange(4) == 0), 0.0, springs), models, scale
     )
     fields = {key: {} for key in ComplianceResult.__slots__[2:]}
     for load, task, preload in zip(problem.loads, tasks, preloads, strict=True):
         case = load.name
-        clamped, delta0 = _clamp(clamping, preload @ bases[:, :, 0], models, case)
+        pushed = preload @ bases[:, :, 0]
+        seated = None if seat is None else _seated(seat, pushed + gravity, case)
+        clamped, delta0 = seated or _clamp(clamping, pushed, gravity, models, case)
+        fields["seated"][case] = seated is not None
         # Every contact becomes a spring about its clamped state; a passive contact that lifted
         # off during clamping keeps its open gap as a negative reference normal force.
         reference = clamped.copy()
@@ -246,9 +282,37 @@ def _system(bases, springs, models, scale) -> SpringSystem:
     )
 
 
-def _clamp(clamping: SpringSystem, wrench, models, case) -> tuple[np.ndarray, np.ndarray]:
-    """Contact forces ``(m, 4)`` and displacement ``(6,)`` after clamping: elastic and exact, or,
-    where no state with every contact sticking exists, one increment with sliding contacts."""
+def _seated(seat: SpringSystem, wrench, case) -> tuple[np.ndarray, np.ndarray] | None:
+    """Contact forces ``(m, 4)`` and displacement ``(6,)`` of the frictionless equilibrium of
+    the clamping and the weight on the locators' normal springs (exact), or ``None`` if there is
+    none."""
+    try:
+        forces, delta = seat.solve(np.zeros_like(seat.springs), wrench, case)[:2]
+    except (NoEquilibriumError, WrongContactSetError, InaccurateStepError):
+        return None
+    return forces, delta
+
+
+def _clamp(clamping: SpringSystem, pushed, gravity, models, case) -> tuple[np.ndarray, ...]:
+    """Contact forces ``(m, 4)`` and displacement ``(6,)`` after stuck clamping, with the weight
+    where the springs can carry it (else without: a grasp without supports, whose preloads
+    balance each other): elastic and exact, or, where no state with every contact sticking
+    exists, one increment with sliding contacts."""
+    try:
+        return _stuck(clamping, pushed + gravity, models, case)
+    except (NoEquilibriumError, InaccurateStepError):  # (Clarabel fails where no spring acts)
+        pass
+    try:
+        return _stuck(clamping, pushed, models, case)
+    except NoEquilibriumError:
+        raise NoEquilibriumError(
+            f"load case {case!r}: the supports and locators cannot balance the clamp and finger "
+            "preloads (with or without the weight) with their normal forces pressing: the "
+            "preloads push the part off them while it is clamped"
+        ) from None
+
+
+def _stuck(clamping: SpringSystem, wrench, models, case) -> tuple[np.ndarray, np.ndarray]:
     try:
         return clamping.solve(np.zeros_like(clamping.springs), wrench, case)[:2]
     except WrongContactSetError:

@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fixplan.errors import ConvergenceError, InvalidArgumentError
+from fixplan.planner.direct_solve import INFEASIBLE, DirectSolver
 
 #: A polished solution is accepted when its equilibrium residual, negative normal forces and
 #: closed gaps of lifted contacts are below this fraction of the step's force scale.
@@ -134,34 +135,60 @@ class ContactQP:
             constraints += model.constraints(load, self.bound[i])
         self._forces = forces
         self._problem = cp.Problem(cp.Minimize(cost), constraints)
+        self._direct, self._tried_direct = None, False
 
     def solve(self, reference, wrench, bound, case: str) -> tuple[np.ndarray, np.ndarray]:
         """Contact forces ``(m, 4)`` and displacement ``(6,)`` of the step: springs about
         ``reference`` ``(m, 4)``, external ``wrench`` ``(6,)``, friction bounds ``bound`` ``(m,)``
-        [N]. Raises :class:`NoEquilibriumError` when nothing balances the load."""
-        import cvxpy as cp
+        [N]. Raises :class:`NoEquilibriumError` when nothing balances the load.
 
+        Solved by Clarabel directly on the compiled data once cvxpy has solved the QP once
+        (:class:`~fixplan.planner.direct_solve.DirectSolver`); through cvxpy where that path
+        does not give an answer."""
         self.reference.value = np.asarray(reference, float).ravel() / self.units
         self.wrench.value = np.asarray(wrench, float) / self.rows
         self.bound.value = np.asarray(bound, float) / self.scale
+        if self._direct is not None:
+            values = self._direct.solve(accept_inaccurate=True)
+            if self._direct.status in INFEASIBLE:
+                raise self._no_equilibrium(case)
+            if values is not None:
+                forces = values[self._forces.id] * self.units
+                if self._direct.status == "Solved" or self._admissible(forces):
+                    dual = self._direct.equality_dual(self.wrench)
+                    return forces.reshape(-1, 4), self._displacement(dual)
+        return self._solve_with_cvxpy(case)
+
+    def _solve_with_cvxpy(self, case: str) -> tuple[np.ndarray, np.ndarray]:
+        import cvxpy as cp
+
         try:
             with warnings.catch_warnings():  # an inaccurate answer is reported below
                 warnings.simplefilter("ignore", UserWarning)
+                # (cvxpy evaluates the cost at an infeasibility certificate's huge values)
+                warnings.simplefilter("ignore", RuntimeWarning)
                 self._problem.solve(solver=cp.CLARABEL, **SOLVER_OPTIONS)
         except cp.SolverError as exc:
             raise InaccurateStepError(f"load case {case!r}: Clarabel failed: {exc}") from exc
         status = self._problem.status
         if status in ("infeasible", "infeasible_inaccurate"):
-            raise NoEquilibriumError(
-                f"load case {case!r}: no contact forces within the contacts' friction and "
-                "unilateral limits balance the load; the body leaves its contacts or slides"
-            )
+            raise self._no_equilibrium(case)
         forces = None if self._forces.value is None else self._forces.value * self.units
         if status != "optimal" and not (
             status == "optimal_inaccurate" and self._admissible(forces)
         ):
             raise InaccurateStepError(f"load case {case!r}: the contact QP ended {status!r}")
-        return forces.reshape(-1, 4), self._displacement()
+        if status == "optimal" and self._direct is None and not self._tried_direct:
+            self._tried_direct = True
+            self._direct = DirectSolver.create(self._problem, SOLVER_OPTIONS)
+        return forces.reshape(-1, 4), self._displacement(self._balance.dual_value)
+
+    @staticmethod
+    def _no_equilibrium(case: str) -> NoEquilibriumError:
+        return NoEquilibriumError(
+            f"load case {case!r}: no contact forces within the contacts' friction and "
+            "unilateral limits balance the load; the body leaves its contacts or slides"
+        )
 
     def _admissible(self, forces) -> bool:
         """Whether ``forces`` (flat, [N]) balance the step's load within the friction and
@@ -183,10 +210,10 @@ class ContactQP:
                 return False
         return True
 
-    def _displacement(self) -> np.ndarray:
+    def _displacement(self, dual) -> np.ndarray:
         """The displacement from the multipliers of equilibrium: the cost is ``2 / w`` times the
         complementary energy in scaled forces, so ``Δδ = w y / 2`` per scaled row."""
-        return 0.5 * self._energy * self._balance.dual_value / self.rows
+        return 0.5 * self._energy * np.asarray(dual, float) / self.rows
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
