@@ -46,7 +46,7 @@ def test_the_direct_path_matches_cvxpy_in_values_objective_and_equality_multipli
         # square root (the objective is strongly convex), in the value to the gap.
         np.testing.assert_allclose(values[x.id], x.value, atol=1e-5)
         assert direct.objective_value == pytest.approx(problem.value, abs=1e-8)
-        dual = direct.equality_dual(parameters[1])
+        dual = direct.dual(balance)
         np.testing.assert_allclose(dual, balance.dual_value, atol=1e-5)
 
 
@@ -62,10 +62,31 @@ def test_a_load_that_nothing_balances_is_reported_infeasible():
     assert direct.status in INFEASIBLE
 
 
-def test_parameters_that_move_the_constraint_matrix_are_refused():
+def test_parameters_that_move_the_constraint_matrix_are_applied():
+    # A load multiple times a parametric wrench, as in the planner's fixed-force objectives.
+    rng = np.random.default_rng(6)
+    x, multiple = cp.Variable(6), cp.Variable()
+    wrench = cp.Parameter(3)
+    matrix = rng.normal(size=(3, 6))
+    balance = matrix @ x + multiple * wrench == 0
+    constraints = [balance, cp.norm(x, 1) <= 1.0]
+    problem = cp.Problem(cp.Maximize(multiple), constraints)
+    wrench.value = rng.normal(size=3)
+    problem.solve(solver=cp.CLARABEL, **SETTINGS)
+    direct = DirectSolver.create(problem, SETTINGS)
+    assert direct is not None
+    for _ in range(5):
+        wrench.value = rng.normal(size=3)
+        problem.solve(solver=cp.CLARABEL, **SETTINGS)
+        values = direct.solve()
+        assert values[multiple.id] == pytest.approx(multiple.value, rel=1e-7)
+        np.testing.assert_allclose(direct.dual(balance), balance.dual_value, atol=1e-6)
+
+
+def test_a_parametric_quadratic_cost_is_refused():
     x = cp.Variable(2)
-    slope = cp.Parameter()
-    problem = cp.Problem(cp.Minimize(cp.sum_squares(x)), [slope * x[0] + x[1] == 1])
-    slope.value = 2.0
+    weight = cp.Parameter(nonneg=True)
+    problem = cp.Problem(cp.Minimize(weight * cp.sum_squares(x) + cp.sum(x)), [x >= -1])
+    weight.value = 2.0
     problem.solve(solver=cp.CLARABEL)
     assert DirectSolver.create(problem, SETTINGS) is None

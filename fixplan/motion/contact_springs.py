@@ -155,7 +155,7 @@ class ContactQP:
             if values is not None:
                 forces = values[self._forces.id] * self.units
                 if self._direct.status == "Solved" or self._admissible(forces):
-                    dual = self._direct.equality_dual(self.wrench)
+                    dual = self._direct.dual(self._balance)
                     return forces.reshape(-1, 4), self._displacement(dual)
         return self._solve_with_cvxpy(case)
 

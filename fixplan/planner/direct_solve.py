@@ -1,15 +1,15 @@
 """Re-solving a compiled DPP problem straight through Clarabel, for control loops.
 
 cvxpy re-solves a DPP problem without recompiling it, but still spends a few milliseconds per
-solve mapping parameters, building the solver and unpacking the answer. When the parameters only
-move the constraint offsets ``b`` and the linear cost ``q`` (the planner's load wrenches and
-fixed forces do, for the force objectives; so do the references, loads and friction bounds of
-the contact-spring steps of :mod:`fixplan.motion.contact_springs`), the conic data ``A`` and
-``P`` are fixed: this module probes the affine maps from parameter values to ``b`` and ``q``
-once, keeps one Clarabel solver whose ``b`` and ``q`` are updated in place, and reads the
-variables (and the multipliers of equality constraints) from the solution vectors. It checks
-itself against cvxpy's answer when it is built and refuses (returns ``None``) where its
-assumptions do not hold.
+solve mapping parameters, building the solver and unpacking the answer. Its compiled program
+keeps the problem data as linear maps of the parameter vector with fixed sparsity patterns:
+``A`` and ``b`` (the planner's load wrenches, given forces and load multiples; the references,
+loads and friction bounds of the contact-spring steps of :mod:`fixplan.motion.contact_springs`)
+and the linear cost ``q``. This module applies those maps itself, keeps one Clarabel solver whose
+``A``, ``b`` and ``q`` are updated in place, and reads the variables and the multipliers of
+equality constraints from the solution vectors. It checks itself against cvxpy's answer when it
+is built and refuses (returns ``None``) where its assumptions do not hold (a parametric ``P``,
+cones Clarabel's direct path does not cover, cvxpy internals it does not recognise).
 """
 
 from __future__ import annotations
@@ -26,92 +26,55 @@ INFEASIBLE = ("PrimalInfeasible", "AlmostPrimalInfeasible")
 
 
 class DirectSolver:
-    """Clarabel on the fixed conic data of ``problem``, with ``b`` and ``q`` affine maps of
-    parameters.
+    """Clarabel on the compiled conic data of ``problem``, with ``A``, ``b`` and ``q`` linear
+    maps of the parameter vector.
 
     Build with :meth:`create` after ``problem`` was solved once by cvxpy with Clarabel.
     """
 
-    def __init__(self, problem, solver, offsets, constant, data_maps):
+    def __init__(self, problem, solver, program, offsets, equalities):
         self._problem = problem
-        self._columns = _parameter_columns(problem.parameters())
         self._solver = solver
+        self._program = program
         self._offsets = offsets
-        self._constant = constant
-        self._q0, self._q_jacobian, self._b0, self._b_jacobian = data_maps
+        self._equalities = equalities
         self.objective_value = float("nan")
         #: Clarabel's status of the last solve.
         self.status = ""
         self._dual = np.zeros(0)
-        self._dual_rows: dict = {}
 
     @classmethod
     def create(cls, problem: cp.Problem, settings: dict) -> DirectSolver | None:
-        """A direct solver for ``problem``, or ``None`` when its parameters move ``A`` or
-        ``P``."""
+        """A direct solver for ``problem``, or ``None`` where its assumptions do not hold."""
         import clarabel
 
         data, _, inverse = problem.get_problem_data(cp.CLARABEL, solver_opts={})
-        program = data[cp.settings.PARAM_PROB]
-        quadratic = program.P is not None
-        parameters = problem.parameters()
-        saved = [p.value for p in parameters]
-
-        def conic_data():
-            if quadratic:
-                return program.apply_parameters(quad_obj=True)
-            return (None, *program.apply_parameters())
-
         try:
-            for p in parameters:
-                p.value = np.zeros(p.shape)
-            p0, q0, d0, a0, b0 = conic_data()
-            q_columns, b_columns = [], []
-            for p in parameters:
-                for index in range(p.size):
-                    unit = np.zeros(p.size)
-                    unit[index] = 1.0
-                    p.value = unit.reshape(p.shape, order="F")
-                    pp, q, _, a, b = conic_data()
-                    if (a != a0).nnz or (quadratic and (pp != p0).nnz):
-                        return None
-                    q_columns.append(q - q0)
-                    b_columns.append(b - b0)
-                    p.value = np.zeros(p.shape)
-        finally:
-            for p, value in zip(parameters, saved, strict=True):
-                p.value = value
+            program = _Program(data[cp.settings.PARAM_PROB], problem.parameters())
+            equalities = _equality_rows(inverse[-1].inverse_data["eq_constr"])
+        except (AttributeError, KeyError, TypeError, ValueError):
+            return None  # cvxpy internals this module does not know
         dims = data["dims"]
+        if dims.exp or dims.psd or dims.p3d or program.parametric_p:
+            return None
         cones = [clarabel.ZeroConeT(dims.zero), clarabel.NonnegativeConeT(dims.nonneg)]
         cones += [clarabel.SecondOrderConeT(k) for k in dims.soc]
-        if dims.exp or dims.psd or dims.p3d:
-            return None
         options = clarabel.DefaultSettings()
         options.verbose = False
         options.presolve_enable = False  # keeps the rows of b, so that it can be updated
         for key, value in settings.items():
             setattr(options, key, value)
-        size = a0.shape[1]
-        objective = sp.csc_matrix((size, size)) if p0 is None else sp.csc_matrix(sp.triu(p0))
-        solver = clarabel.DefaultSolver(
-            objective, np.asarray(q0), sp.csc_matrix(-a0), np.asarray(b0), cones, options
-        )
-        maps = (np.asarray(q0), _jacobian(q_columns), np.asarray(b0), _jacobian(b_columns))
+        vector = program.parameter_vector()
+        q, _ = program.cost(vector)
+        a, b = program.constraints(vector)
+        solver = clarabel.DefaultSolver(program.quadratic, q, a, b, cones, options)
         # The offsets of the variables in Clarabel's x: those of the matrix stuffing, the last
         # reduction that sees variables (canonicalisation may add auxiliary ones before them).
         offsets = [d.var_offsets for d in inverse if hasattr(d, "var_offsets")][-1]
-        direct = cls(problem, solver, offsets, float(d0), maps)
+        direct = cls(problem, solver, program, offsets, equalities)
         if not direct._agrees_with_cvxpy():
             return None
         return direct
-
-    def _parameter_vector(self) -> np.ndarray:
-        return np.concatenate(
-            [
-                np.ravel(np.asarray(p.value, dtype=float), order="F")
-                for p in self._problem.parameters()
-            ]
-        )
 
     def solve(self, *, accept_inaccurate: bool = False) -> dict | None:
         """Variable values by id after a solve with the parameters' current values.
@@ -120,18 +83,19 @@ class DirectSolver:
         ``accept_inaccurate``); :attr:`status` says why (use cvxpy then: it turns infeasibility
         into certificates).
         """
-        vector = self._parameter_vector()
-        update = {
-            "b": self._b0 if self._b_jacobian is None else self._b0 + self._b_jacobian @ vector
-        }
-        if self._q_jacobian is not None:
-            update["q"] = self._q0 + self._q_jacobian @ vector
+        vector = self._program.parameter_vector()
+        q, constant = self._program.cost(vector)
+        a, b = self._program.constraints(vector)
+        update = {"q": q, "b": b}
+        if a is not None:
+            update["A"] = a.data  # the same pattern, so only the values change
         self._solver.update(**update)
         solution = self._solver.solve()
         self.status = str(solution.status)
         if self.status != "Solved" and not (accept_inaccurate and self.status == "AlmostSolved"):
             return None
-        self.objective_value = float(solution.obj_val) + self._constant
+        value = float(solution.obj_val) + constant  # of the minimisation cvxpy compiled
+        self.objective_value = -value if isinstance(self._problem.objective, cp.Maximize) else value
         self._dual = np.asarray(solution.z)
         x = np.asarray(solution.x)
         values = {}
@@ -141,18 +105,14 @@ class DirectSolver:
             values[variable.id] = chunk.reshape(variable.shape, order="F")
         return values
 
-    def equality_dual(self, parameter: cp.Parameter) -> np.ndarray:
-        """Multipliers, after :meth:`solve`, of the equality constraint ``expression +
-        parameter == 0`` in which ``parameter`` (a vector) appears alone, as cvxpy gives them
-        (``constraint.dual_value``)."""
-        if parameter.id not in self._dual_rows:
-            block = self._b_jacobian[:, self._columns[parameter.id]].toarray()
-            rows = np.argmax(np.abs(block), axis=0)
-            # Clarabel's row a·x + s = b with b = c p_j (s = 0) is cvxpy's (a/c)·x + ... == 0
-            # scaled by c: cvxpy's multiplier is the row's times -c.
-            self._dual_rows[parameter.id] = rows, -block[rows, np.arange(len(rows))]
-        rows, coefficients = self._dual_rows[parameter.id]
-        return coefficients * self._dual[rows]
+    def dual(self, constraint: cp.Constraint) -> np.ndarray | None:
+        """The multipliers of equality ``constraint`` after :meth:`solve`, as cvxpy gives them
+        (``constraint.dual_value``); ``None`` if it is not one of the problem's equalities."""
+        found = self._equalities.get(constraint.id)
+        if found is None:
+            return None
+        start, size, shape = found
+        return self._dual[start : start + size].reshape(shape, order="F")
 
     def _agrees_with_cvxpy(self) -> bool:
         """Same optimal value as cvxpy, and the variables feasible for cvxpy's constraints.
@@ -167,10 +127,11 @@ class DirectSolver:
         try:
             for variable in self._problem.variables():
                 variable.save_value(values[variable.id])
-            feasible = all(
-                np.all(np.asarray(c.violation()) <= AGREEMENT_RTOL * max(1.0, abs(expected)))
-                for c in self._problem.constraints
-            )
+            with np.errstate(divide="ignore", invalid="ignore"):  # cones at their apex
+                feasible = all(
+                    np.all(np.asarray(c.violation()) <= AGREEMENT_RTOL * max(1.0, abs(expected)))
+                    for c in self._problem.constraints
+                )
         finally:
             for variable in self._problem.variables():
                 variable.save_value(saved[variable.id])
@@ -178,18 +139,71 @@ class DirectSolver:
         return feasible and abs(self.objective_value - expected) <= AGREEMENT_RTOL * scale
 
 
-def _jacobian(columns) -> sp.csc_array | None:
-    """The sparse matrix of probed columns, or ``None`` when every column is zero."""
-    if not columns:
-        return None
-    matrix = sp.csc_array(np.column_stack(columns))
-    return matrix if matrix.nnz else None
+class _Program:
+    """cvxpy's compiled conic program as linear maps of the parameter vector, applied in numpy
+    (``P`` constant; the patterns of ``A`` and ``b`` fixed)."""
+
+    def __init__(self, program, parameters):
+        self._columns = [
+            (p, program.param_id_to_col[p.id], p.size) for p in parameters
+        ]  # fmt: skip
+        self._size = program.total_param_size + 1  # the last entry is the constant 1
+        self._variables = program.x.size
+        self._q = sp.csr_array(program.q)
+        program.reduced_A.cache()
+        self._a_map = sp.csr_array(program.reduced_A.reduced_mat)
+        indices, indptr, shape = program.reduced_A.problem_data_index
+        self._a_rows = np.asarray(indices)
+        self._split = int(indptr[-2])  # entries of A; the rest are b's, in the last column
+        self._a_shape = (int(shape[0]), int(shape[1]) - 1)
+        self._a_indptr = np.asarray(indptr[:-1])
+        self._a_fixed = self._a_map[:, : self._size - 1][: self._split].nnz == 0
+        if program.reduced_P is None or program.reduced_P.matrix_data is None:
+            self.quadratic = sp.csc_matrix((self._variables, self._variables))
+            self.parametric_p = False
+        else:
+            program.reduced_P.cache()
+            p_map = sp.csr_array(program.reduced_P.reduced_mat)
+            self.parametric_p = p_map[:, :-1].nnz > 0
+            p_indices, p_indptr, p_shape = program.reduced_P.problem_data_index
+            values = p_map @ np.r_[np.zeros(self._size - 1), 1.0]
+            full = sp.csc_matrix((values, p_indices, p_indptr), shape=p_shape)
+            self.quadratic = sp.csc_matrix(sp.triu(full))
+        self._a_built = False
+
+    def parameter_vector(self) -> np.ndarray:
+        vector = np.zeros(self._size)
+        vector[-1] = 1.0
+        for parameter, column, size in self._columns:
+            vector[column : column + size] = np.ravel(parameter.value, order="F")
+        return vector
+
+    def cost(self, vector) -> tuple[np.ndarray, float]:
+        """``q`` and the constant of the cost."""
+        full = self._q @ vector
+        return full[: self._variables], float(full[self._variables])
+
+    def constraints(self, vector) -> tuple[sp.csc_matrix | None, np.ndarray]:
+        """Clarabel's ``A`` (``None`` after the first call when it does not depend on the
+        parameters) and ``b``: cvxpy's ``A x + b`` in the cones is ``b_C - A_C x`` with
+        ``A_C = -A``, ``b_C = b``."""
+        values = self._a_map @ vector
+        b = np.zeros(self._a_shape[0])
+        b[self._a_rows[self._split :]] = values[self._split :]
+        if self._a_built and self._a_fixed:
+            return None, b
+        self._a_built = True
+        a = sp.csc_matrix(
+            (-values[: self._split], self._a_rows[: self._split], self._a_indptr),
+            shape=self._a_shape,
+        )
+        return a, b
 
 
-def _parameter_columns(parameters) -> dict:
-    """Column indices of each parameter (by id) in the probed parameter vector."""
-    columns, start = {}, 0
-    for p in parameters:
-        columns[p.id] = np.arange(start, start + p.size)
-        start += p.size
-    return columns
+def _equality_rows(constraints) -> dict:
+    """Row offset, size and shape of each equality constraint (by id) in Clarabel's zero cone."""
+    rows, start = {}, 0
+    for constraint in constraints:
+        rows[constraint.id] = (start, constraint.size, constraint.shape)
+        start += constraint.size
+    return rows

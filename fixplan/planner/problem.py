@@ -144,6 +144,7 @@ class Body:
     mass: float
     center_of_mass: np.ndarray
     gravity: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, -9.81]))
+    _weight: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         mass = _scalar("body.mass", self.mass, limit=MAX_MASS, units="kg")
@@ -152,12 +153,15 @@ class Body:
         object.__setattr__(self, "mass", mass)
         object.__setattr__(self, "center_of_mass", center)
         object.__setattr__(self, "gravity", gravity)
+        force = mass * gravity
+        weight = np.concatenate([force, np.cross(center, force)])
+        weight.setflags(write=False)
+        object.__setattr__(self, "_weight", weight)
 
     @property
     def weight_wrench(self) -> np.ndarray:
-        """Gravity wrench ``(force [N], moment about the world origin [N m])``."""
-        force = self.mass * self.gravity
-        return np.concatenate([force, np.cross(self.center_of_mass, force)])
+        """Gravity wrench ``(force [N], moment about the world origin [N m])`` (read-only)."""
+        return self._weight
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

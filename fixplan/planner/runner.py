@@ -3,8 +3,9 @@
 A :class:`Runner` keeps one compiled problem per objective. The fixed-force objectives solve
 their load cases (independent, since the active forces are given) in blocks of
 ``CASES_PER_BLOCK``, so that one compiled problem serves any number of cases; force objectives
-solve all cases at once. Force objectives re-solve straight through Clarabel once the same
-problem has been solved twice (:mod:`fixplan.planner.direct_solve`). A solver failure retries
+solve all cases at once. A compiled problem is re-solved straight through Clarabel once cvxpy
+has solved it twice (:mod:`fixplan.planner.direct_solve`): re-solves of a force objective with
+new loads, and the blocks of a fixed-force objective after the second. A solver failure retries
 once with a fallback solver.
 """
 
@@ -18,7 +19,7 @@ import numpy as np
 from fixplan.errors import FixplanError, InvalidArgumentError
 from fixplan.planner.direct_solve import DirectSolver
 from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, Problem
-from fixplan.planner.stacking import ContactLayout, Stacked, build, set_given
+from fixplan.planner.stacking import ContactLayout, Stacked, build, normal_forces, set_given
 
 SOLVERS = ("CLARABEL", "OSQP", "SCS")
 
@@ -162,20 +163,21 @@ class Runner:
         """Solve straight through Clarabel when a direct solver exists for ``objective``."""
         direct = self._direct.get(objective)
         values = None if direct is None else direct.solve()
-        if values is None:
+        dual = None if values is None else direct.dual(stacked.balance)
+        if dual is None:
             return None
         for variable in stacked.problem.variables():
             variable.save_value(values[variable.id])
         return {"status": "optimal", "solver": "CLARABEL (direct)", "warnings": [],
-                **_values(stacked)}  # fmt: skip
+                **_values(stacked), "dual": np.asarray(dual, dtype=float)}  # fmt: skip
 
     def _prepare_direct(self, objective: str, stacked: Stacked) -> None:
-        """Build the direct solver of a force objective after its second cvxpy solve.
+        """Build the direct solver of an objective after its second cvxpy solve.
 
         It is checked against that solve's answer (same parameters); one-off problems never
         pay for it.
         """
-        if self.solver != "CLARABEL" or objective in FIXED_FORCE_OBJECTIVES:
+        if self.solver != "CLARABEL":
             return
         if objective in self._direct or stacked.problem.status != cp.OPTIMAL:
             return
@@ -190,9 +192,9 @@ class Runner:
 
 def _values(stacked: Stacked) -> dict:
     return {
-        "normal": np.asarray(stacked.normal.value, dtype=float),
+        "normal": normal_forces(stacked),
         "friction": np.asarray(stacked.friction.value, dtype=float),
-        "scale": np.asarray(stacked.scale.value, dtype=float).ravel(),
+        "scale": np.ravel(stacked.scale.value).astype(float),
     }
 
 

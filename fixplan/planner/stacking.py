@@ -133,6 +133,9 @@ class Stacked:
         ``(passive contacts, K)``: 1 where a passive contact is held without normal force.
     normal : cvxpy.Expression
         ``(C, K)`` normal forces.
+    normal_parts : tuple
+        ``(contact indices, variable or parameter)`` pairs that make up ``normal`` (a 1-D one
+        is the same in every case): :func:`normal_forces` evaluates it in numpy.
     friction : cvxpy.Variable
         ``(D, K)`` friction loads.
     scale : cvxpy.Expression
@@ -153,6 +156,7 @@ class Stacked:
     sense: cp.Parameter | None
     unloaded: cp.Parameter | None
     normal: cp.Expression
+    normal_parts: tuple
     friction: cp.Variable
     scale: cp.Expression
     balance: cp.Constraint
@@ -191,10 +195,11 @@ def build(
         "given-finger": cp.Parameter((len(groups["given-finger"]), cases), nonneg=True),
         "given-clamp": cp.Parameter(len(groups["given-clamp"]), nonneg=True),
     }
-    normal = 0
+    normal, normal_parts = 0, []
     for key, index in groups.items():
         if not index:
             continue
+        normal_parts.append((np.asarray(index), pieces[key]))
         piece = pieces[key]
         if piece.ndim == 1:
             piece = cp.reshape(piece, (len(index), 1), order="F") @ ones
@@ -275,11 +280,22 @@ def build(
         sense=sense,
         unloaded=unloaded,
         normal=normal,
+        normal_parts=tuple(normal_parts),
         friction=friction,
         scale=scale,
         balance=balance,
         decided=decided,
     )
+
+
+def normal_forces(stacked: Stacked) -> np.ndarray:
+    """The normal forces ``(C, K)`` [N] of the last solve, from the values of their parts."""
+    cases = stacked.task.shape[1]
+    normal = np.zeros((len(stacked.decided), cases))
+    for index, piece in stacked.normal_parts:
+        values = np.asarray(piece.value, dtype=float)
+        normal[index] = values if values.ndim == 2 else values[:, None]
+    return normal
 
 
 def set_given(stacked: Stacked, values: dict, cases: int) -> None:
