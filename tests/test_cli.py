@@ -77,6 +77,18 @@ def test_plan_prints_a_readable_summary(tmp_path, capsys):
     assert "if it slips, the part rotates about an axis through" in out
 
 
+def test_verbose_plan_logs_the_time_of_each_stage(tmp_path, caplog):
+    import re
+
+    with caplog.at_level("INFO"):
+        assert main(["plan", str(write(tmp_path)), "-v"]) == EXIT_OK
+    line = next(r.getMessage() for r in caplog.records if r.getMessage().startswith("time:"))
+    stages = dict(re.findall(r"(imports|read|build|solve|output) (\d+\.\d+) s", line))
+    assert list(stages) == ["imports", "read", "build", "solve", "output"]
+    total = float(re.search(r"total (\d+\.\d+) s", line).group(1))
+    assert sum(map(float, stages.values())) == pytest.approx(total, abs=0.003)  # rounding
+
+
 def test_plan_json_has_the_documented_fields(tmp_path, capsys):
     assert main(["plan", str(write(tmp_path)), "--json"]) == EXIT_OK
     document = json.loads(capsys.readouterr().out)

@@ -218,6 +218,25 @@ def _build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _Stopwatch:
+    """Wall-clock time of the stages of a command [s], for ``-v``."""
+
+    def __init__(self):
+        self._last = time.perf_counter()
+        self._start = self._last
+        self.laps: list[tuple[str, float]] = []
+
+    def lap(self, stage: str) -> None:
+        """End ``stage`` now."""
+        now = time.perf_counter()
+        self.laps.append((stage, now - self._last))
+        self._last = now
+
+    def __str__(self) -> str:
+        stages = ", ".join(f"{stage} {seconds:.3f} s" for stage, seconds in self.laps)
+        return f"{stages}; total {self._last - self._start:.3f} s"
+
+
 class _Progress:
     """A progress bar on stderr, drawn only when stderr is a terminal."""
 
@@ -379,12 +398,15 @@ def _check_output_file(path: Path, option: str) -> None:
 
 
 def _run_plan(args: argparse.Namespace) -> tuple[int, str]:
+    clock = _Stopwatch()
     from fixplan.planner.planner import Planner
     from fixplan.planner.problem import COMPLIANT_OBJECTIVE
 
+    clock.lap("imports")
     problem_file = _load(args.file, args.model, args.objective)
     if args.report is not None:
         _check_output_folder(args.report, "--report")
+    clock.lap("read")
     try:
         planner = Planner(problem_file.problem, solver=args.solver)
     except InvalidArgumentError:
@@ -393,10 +415,14 @@ def _run_plan(args: argparse.Namespace) -> tuple[int, str]:
         # Names the file and the contact at fault.
         check_problem(args.file, model=args.model, objective=args.objective)
         raise
+    clock.lap("build")
     log.info("solving %s (%d load cases)", args.file, len(problem_file.problem.loads))
     plan = planner.solve(progress=_Progress("solving", not args.quiet))
+    clock.lap("solve")
     compliant = plan.objective == COMPLIANT_OBJECTIVE
     result = _compliant(problem_file, plan) if compliant else None
+    if compliant:
+        clock.lap("compliant analysis")
     if args.report is not None:
         from fixplan.io.report import write_report
 
@@ -409,8 +435,12 @@ def _run_plan(args: argparse.Namespace) -> tuple[int, str]:
                                "sha256": problem_file.sha256}  # fmt: skip
         if compliant:
             document["compliant"] = summary
-        return _exit_code(plan), _json(document)
-    return _exit_code(plan), "\n".join([_summary(problem_file, plan), *lines])
+        output = _json(document)
+    else:
+        output = "\n".join([_summary(problem_file, plan), *lines])
+    clock.lap("output")
+    log.info("time: %s", clock)
+    return _exit_code(plan), output
 
 
 # -- push ----------------------------------------------------------------------------------------
