@@ -239,6 +239,17 @@ def test_verification_flags_a_wrench_outside_its_friction_set():
     assert any("'right' exceeds its friction set" in p for p in problems)
 
 
+def test_verification_flags_a_pulling_contact_and_friction_without_normal_force():
+    planner = Planner(pinch("point-cone", load=off_axis_load(offset=0.0)))
+    normal = np.array([[-1.0], [0.0]])  # the left finger pulls; the right one is not pressed
+    friction = np.array([[0.0], [0.0], [2.0], [0.0]])  # yet carries 2 N
+    wrenches = np.column_stack([off_axis_load(offset=0.0).wrench])
+    answer = {"normal": normal, "friction": friction, "scale": np.ones(1)}
+    _, problems = verify(planner.problem, planner.layout, planner.models, answer, wrenches, 0.02)
+    assert any("'left' pulls: normal force -1 N" in p for p in problems)
+    assert any("'right' carries friction without normal force" in p for p in problems)
+
+
 def test_three_point_contact_set_surface_equals_the_planar_limit_surface_of_the_points():
     xy = np.array([[0.03, 0.0], [-0.02, 0.025], [-0.02, -0.03]])
     forces = np.array([4.0, 8.0, 6.0])

@@ -48,22 +48,32 @@ def verify(
                 f"wrenches involved ({size[worst]:.3g} {unit})"
             )
     scale_force = max(float(np.abs(normal).max()), 1e-12)
-    for i, (contact, model) in enumerate(zip(problem.contacts, models, strict=True)):
-        fn = normal[i]
-        if np.any(fn < -FRICTION_SET_RTOL * scale_force):
-            problems.append(f"contact {contact.name!r} pulls: normal force {fn.min():.3g} N")
+    noise = FRICTION_SET_RTOL * scale_force
+    pressed = normal > noise
+    starts = [part.start for part in layout.slices]
+    # Largest friction component of each contact and case (a contact without friction: 0).
+    widths = np.array([part.stop - part.start for part in layout.slices])
+    loose = np.zeros_like(normal)
+    if friction.size:
+        sizes = np.abs(friction)
+        carried = np.maximum.reduceat(sizes, np.minimum(starts, len(sizes) - 1), axis=0)
+        loose = np.where(widths[:, None] > 0, carried, 0.0) > noise
+    for i in np.flatnonzero((normal < -noise).any(axis=1)):
+        name = problem.contacts[i].name
+        problems.append(f"contact {name!r} pulls: normal force {normal[i].min():.3g} N")
+    for i in np.flatnonzero((loose & ~pressed).any(axis=1)):
+        problems.append(
+            f"contact {problem.contacts[i].name!r} carries friction without normal force"
+        )
+    for i in np.flatnonzero((loose & pressed).any(axis=1)):
+        contact, model, fn = problem.contacts[i], models[i], normal[i]
         load = friction[layout.slices[i]].T
-        noise = FRICTION_SET_RTOL * scale_force
-        pressed = fn > noise
-        loose = np.abs(load).max(axis=1) > noise
-        if np.any(loose & ~pressed):
-            problems.append(f"contact {contact.name!r} carries friction without normal force")
         # The excess of a contact's friction over its set, as a force, against the largest
         # normal force: solver accuracy is absolute, so a lightly pressed contact may exceed its
         # own set by more than FRICTION_SET_RTOL in relative terms and still be exact enough.
         excess = (friction_use(model, load, fn, noise=noise) - 1.0) * np.maximum(fn, noise)
-        if np.any(pressed & (excess > noise)):
-            worst = int(np.argmax(np.where(pressed, excess, -np.inf)))
+        if np.any(pressed[i] & (excess > noise)):
+            worst = int(np.argmax(np.where(pressed[i], excess, -np.inf)))
             problems.append(
                 f"contact {contact.name!r} exceeds its friction set by {excess[worst]:.3g} N "
                 f"(over {FRICTION_SET_RTOL:g} of the largest normal force, {scale_force:.3g} N)"
