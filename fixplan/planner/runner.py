@@ -19,7 +19,14 @@ import numpy as np
 from fixplan.errors import FixplanError, InvalidArgumentError
 from fixplan.planner.direct_solve import DirectSolver
 from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, Problem
-from fixplan.planner.stacking import ContactLayout, Stacked, build, normal_forces, set_given
+from fixplan.planner.stacking import (
+    ContactLayout,
+    Stacked,
+    assign,
+    build,
+    normal_forces,
+    set_given,
+)
 
 SOLVERS = ("CLARABEL", "OSQP", "SCS")
 
@@ -129,15 +136,13 @@ class Runner:
 
     def _run_block(self, objective, wrenches, given, sense, unloaded, accurate) -> dict:
         stacked = self.stacked(objective)
-        stacked.task.value = wrenches
-        stacked.gravity.value = self.problem.body.weight_wrench
+        assign(stacked.task, wrenches)
+        assign(stacked.gravity, self.problem.body.weight_wrench)
         set_given(stacked, given, wrenches.shape[1])
         if stacked.sense is not None:
-            stacked.sense.value = float(sense)
+            assign(stacked.sense, float(sense))
         if stacked.unloaded is not None:
-            stacked.unloaded.value = (
-                np.zeros(stacked.unloaded.shape) if unloaded is None else unloaded.astype(float)
-            )
+            assign(stacked.unloaded, 0.0 if unloaded is None else unloaded.astype(float))
         direct = None if accurate else self._direct_result(objective, stacked)
         if direct is not None:
             return direct

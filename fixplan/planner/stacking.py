@@ -311,6 +311,13 @@ def set_given(stacked: Stacked, values: dict, cases: int) -> None:
         else:
             clamp_values[row] = float(np.ravel(value)[0])
     if fingers is not None:
-        fingers.value = finger_values
+        assign(fingers, finger_values)
     if clamps is not None:
-        clamps.value = clamp_values
+        assign(clamps, clamp_values)
+
+
+def assign(parameter: cp.Parameter, value) -> None:
+    """Set ``parameter`` to ``value`` (broadcast to its shape) without cvxpy's validation,
+    which costs more than a direct re-solve: the planner's values are checked where they come
+    from (loads, given forces >= 0, multiples)."""
+    parameter.save_value(np.broadcast_to(np.asarray(value, dtype=float), parameter.shape).copy())
