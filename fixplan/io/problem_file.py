@@ -127,7 +127,6 @@ from fixplan.planner.problem import (
     Load,
     Problem,
 )
-from fixplan.surface import pressure
 from fixplan.tolerances import (
     MAX_ACCELERATION,
     MAX_FACETS,

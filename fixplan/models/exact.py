@@ -13,7 +13,7 @@ twists (:meth:`Exact.conic_form`, an outer polytope, homogeneous in ``N``), and 
 gives the tangent plane at the ray of any load, the cut that removes that load when it lies
 outside. The planner adds such cuts until every contact load lies inside its exact surface
 (:mod:`fixplan.planner.cuts`); used on its own, :meth:`constraints` states the seed polytope
-only, which holds the exact set (:attr:`Exact.seed_error` says by how much).
+only, which holds the exact set (:attr:`Exact.constraint_error` says by how much).
 
 A frictionless contact keeps the shape of its patch (:attr:`LimitSurface.friction_shape`):
 its set is the load 0 and its motion the limit ``mu → 0+`` (:mod:`fixplan.models.base`).
@@ -96,9 +96,9 @@ class Exact(FrictionModel):
         return Exact(surface=self.surface.friction_shape)
 
     @property
-    def seed_error(self) -> float:
+    def constraint_error(self) -> float:
         """Largest relative radial gap of the seed polytope (:meth:`constraints`) to the exact
-        surface, over its vertices [-] (the polytope holds the surface)."""
+        surface [-], read at the polytope's vertices (the polytope holds the surface)."""
         from scipy.spatial import ConvexHull
 
         hull = ConvexHull(self._seed)

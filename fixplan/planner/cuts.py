@@ -80,9 +80,7 @@ class CutPool:
     @classmethod
     def of(cls, models, slices, normal, friction) -> CutPool | None:
         """The pool of the exact models among ``models`` (one per contact), or ``None``."""
-        exact = {
-            i: m for i, m in enumerate(models) if isinstance(m, Exact) and not m.frictionless
-        }
+        exact = {i: m for i, m in enumerate(models) if isinstance(m, Exact) and not m.frictionless}
         return cls(exact, slices, normal, friction) if exact else None
 
     def converge(self, solve: Callable[[], str], status: str) -> tuple[str, list[str]]:
