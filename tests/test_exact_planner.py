@@ -158,7 +158,7 @@ def test_point_supports_are_planned_on_their_facets_exactly():
     problem = Problem(body=body, contacts=[support], loads=[push], objective="max-safety-factor")
     plan = Planner(problem).solve()
     assert plan.status == "optimal"
-    assert plan.safety_factors["push"] == pytest.approx(1.0, rel=1e-9)
+    assert plan.safety_factors["push"] == pytest.approx(1.0, rel=OPTIMUM_RTOL)
     vx, vy, w = plan.motions["push"].twist[[0, 1, 5]]
     np.testing.assert_allclose([-vy / w, vx / w], xy, rtol=1e-6)  # centre of rotation
 

@@ -123,11 +123,14 @@ class Exact(FrictionModel):
             ``(K,)`` ``1 / s - 1`` for the exact safety factor ``s`` of each load at unit
             normal force: positive outside the set.
         """
-        scale = self.surface.normal_force
-        twists, safety = self.surface.motion_and_safety_factor(loads * scale)
-        twists = np.atleast_2d(twists)
-        support = np.atleast_1d(self.surface.support(twists)) / scale
-        return twists / support[:, None], 1.0 / np.atleast_1d(safety) - 1.0
+        twists, safety = self.surface.motion_and_safety_factor(loads * self.surface.normal_force)
+        return self.planes(np.atleast_2d(twists)), 1.0 / np.atleast_1d(safety) - 1.0
+
+    def planes(self, twists: np.ndarray) -> np.ndarray:
+        r"""Tangent planes :math:`a \cdot L \le N`, ``a = V / h_1(V)``, of the exact set at the
+        nonzero twists ``V`` ``(K, 3)``; ``a`` ``(K, 3)``."""
+        support = np.atleast_1d(self.surface.support(twists)) / self.surface.normal_force
+        return twists / support[:, None]
 
     def _loads(self, q):
         """Loads at the surface's normal force along the normalised loads ``q``."""

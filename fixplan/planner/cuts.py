@@ -32,10 +32,19 @@ from fixplan.models.exact import Exact
 from fixplan.tolerances import EXACT_CUT_RTOL, FRICTION_SET_RTOL
 
 #: Cut rows per (exact contact, load case) besides the seed polytope.
-CUT_SLOTS = 8
+CUT_SLOTS = 12
+
+#: Spread of the four planes added around each cut, in normalised twist coordinates, per square
+#: root of the load's excess (the distance to the optimum's normal shrinks like that root).
+SPREAD = 1.0
 
 #: Most solves of one problem while cutting; a problem not converged by then is reported.
 MAX_CUT_ROUNDS = 60
+
+#: Cuts are tightened by this fraction (``a (1 + CUT_MARGIN) · ℓ <= n``) so that the solver's
+#: feasibility error (about 1e-9 of the loads) does not leave a load outside by more than
+#: ``EXACT_CUT_RTOL``; the optimum moves by about this fraction.
+CUT_MARGIN = 1e-8
 
 #: A cut counts as active when its slack is below this fraction of the normal force.
 ACTIVE_RTOL = 1e-7
@@ -127,10 +136,29 @@ class CutPool:
             worst = max(worst, float(excess.max()))
             cut = excess > EXACT_CUT_RTOL
             cases, planes = cases[cut], planes[cut]
-            slots = np.argmin(self._used[:, e, cases], axis=0)
-            self._planes[:, slots, e, cases] = planes.T
-            self._used[slots, e, cases] = self._round
+            if cases.size == 0:
+                continue
+            around = _around(planes, model.rho, SPREAD * np.sqrt(excess[cut]))
+            for rows in (planes, *model.planes(around.reshape(-1, 3)).reshape(4, -1, 3)):
+                slots = np.argmin(self._used[:, e, cases], axis=0)
+                self._planes[:, slots, e, cases] = rows.T * (1.0 + CUT_MARGIN)
+                self._used[slots, e, cases] = self._round
         shape = self._parameters[0].shape
         for axis, parameter in enumerate(self._parameters):
             parameter.value = self._planes[axis].reshape(shape)
         return worst
+
+
+def _around(twists: np.ndarray, rho: float, spread: np.ndarray) -> np.ndarray:
+    """Four twists ``(4, K, 3)`` around each twist of ``twists`` ``(K, 3)``, tilted by ``±spread``
+    along two directions normal to it in normalised coordinates ``(vx, vy, rho w)``."""
+    scale = np.array([1.0, 1.0, rho])
+    unit = twists * scale
+    unit /= np.linalg.norm(unit, axis=1, keepdims=True)
+    helper = np.eye(3)[np.argmin(np.abs(unit), axis=1)]
+    first = np.cross(unit, helper)
+    first /= np.linalg.norm(first, axis=1, keepdims=True)
+    second = np.cross(unit, first)
+    tilt = np.minimum(spread, 0.5)[:, None]
+    around = [unit + tilt * first, unit - tilt * first, unit + tilt * second, unit - tilt * second]
+    return np.array(around) / scale
