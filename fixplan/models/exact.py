@@ -116,7 +116,8 @@ class Exact(FrictionModel):
         Returns
         -------
         planes : numpy.ndarray
-            ``(K, 3)`` rows ``a`` [1/N-units of the load] with the plane :math:`a \cdot L \le N`:
+            ``(K, 3)`` rows ``a`` [-, -, 1/m] with the plane :math:`a \cdot L \le N` for loads
+            ``L`` [N, N, N m] at normal force ``N`` [N]:
             ``a = V / h_1(V)`` for the sliding twist ``V`` of the load (a facet's own plane
             for a load beyond a facet of point supports).
         excess : numpy.ndarray
