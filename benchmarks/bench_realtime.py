@@ -73,7 +73,7 @@ def main() -> None:
         planner = Planner(problem)
         for warm in path[:3]:  # compile, then build the direct solvers
             planner.solve(warm)
-        bare = timings(lambda x: planner.solve(x, analyse=False), path)
+        bare = timings(lambda x, planner=planner: planner.solve(x, analyse=False), path)
         analysed = timings(planner.solve, path[: max(count // 10, 10)])
         stacked = planner._runner.stacked(problem.objective)
 

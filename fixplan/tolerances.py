@@ -33,6 +33,10 @@ EQUILIBRIUM_RTOL = 1e-6
 #: A contact wrench may exceed its friction set by this fraction before verification fails.
 FRICTION_SET_RTOL = 1e-6
 
+#: Contact loads of exact friction models lie inside their exact limit surfaces to this relative
+#: excess (``1 / s - 1``) in a plan: the planner adds tangent-plane cuts until they do.
+EXACT_CUT_RTOL = 1e-9
+
 #: Fixed-force objectives cap each load scale here; a case that reaches the cap is reported with
 #: an infinite safety factor (held at any practical multiple). A higher cap makes the conic
 #: problems badly scaled (reactions a million times the loads).
@@ -127,10 +131,6 @@ MAX_GRID_CELLS = 4096
 #: Largest magnitude of a relative weight or pressure (points' weights, grid values): they are
 #: ratios, so any scale will do, and sums of up to ``MAX_GRID_CELLS`` of them stay finite.
 MAX_RELATIVE_VALUE = 1e12
-
-#: Most friction disks the planner's exact model may discretise one patch into (about five
-#: seconds of model building and solving per patch at this size).
-MAX_EXACT_POINTS = 8192
 
 #: Smallest patch dimension [m] (a nanometre): below it the limit surface's arithmetic
 #: underflows.

@@ -258,17 +258,17 @@ def test_a_polygon_with_too_many_vertices_is_invalid_input(tmp_path, capsys):
     )
 
 
-def test_the_exact_model_of_too_fine_a_patch_is_invalid_input(tmp_path, capsys):
+def test_the_exact_model_plans_a_grid_patch_as_the_ellipsoid_does(tmp_path, capsys):
+    # The exact model states the grid's own limit surface (no friction disks to count).
     x = [(k - 5.5) / 1000 for k in range(12)]
     patch = f'patch = {{ shape = "grid", x = {x}, y = {x}, values = {[[1.0] * 12] * 12} }}'
     path = edited(tmp_path, ('patch = { shape = "disk", radius = 0.008, pressure = "hertz" }',
                              patch))  # fmt: skip
     assert main(["check", str(path), "--json"]) == EXIT_OK
     capsys.readouterr()
-    assert main(["plan", str(path), "--model", "exact"]) == EXIT_INVALID_INPUT
-    assert "contacts[0].patch: the exact model would split this patch into 9216 friction disks" in (
-        capsys.readouterr().err
-    )
+    for model in ("exact", "ellipsoid"):
+        assert main(["plan", str(path), "--model", model]) == EXIT_OK
+        assert "status     optimal" in capsys.readouterr().out
 
 
 def test_a_failed_run_writes_no_report(tmp_path, capsys):

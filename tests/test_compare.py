@@ -226,13 +226,12 @@ def test_fitted_ellipsoid_halves_the_mean_error_of_the_table_2_ellipsoid():
     )
 
 
-def test_exact_model_error_is_its_quadrature_error():
+def test_exact_model_has_no_error():
     ls = _surface(SHAPES["rectangle 10:1"])
     model = Exact.from_limit_surface(ls)
     accuracy = compare(model, ls, n=400)
-    assert max(accuracy.max_overestimate, accuracy.max_underestimate) < 2e-3
-    assert model.quadrature_error < 2e-3
-    assert accuracy.max_motion_angle < math.radians(3.0)
+    assert max(accuracy.max_overestimate, accuracy.max_underestimate) < 1e-12
+    assert accuracy.max_motion_angle < 1e-9
 
 
 # -- point contacts -------------------------------------------------------------------------------

@@ -170,7 +170,9 @@ DIRECT = {
     "pyramid": lambda mu: Pyramid(mu=mu, rho=0.01, facets=6, inscribed=False),
     "point-cone": lambda mu: PointCone(mu=mu),
     "point-pyramid": lambda mu: PointPyramid(mu=mu, facets=8),
-    "exact": lambda mu: Exact(points=POINTS, capacity=CAPACITY, frictionless=mu == 0.0),
+    "exact": lambda mu: Exact(
+        surface=LimitSurface(pressure.points(POINTS, CAPACITY, centered=False), mu=mu)
+    ),
 }
 
 
@@ -195,9 +197,9 @@ def test_a_model_built_with_mu_zero_holds_only_the_zero_load_and_moves_as_with_m
     np.testing.assert_allclose(load.value, 0.0, atol=1e-9)
 
 
-def test_an_exact_model_without_capacity_asks_for_the_frictionless_flag():
-    with pytest.raises(InvalidArgumentError, match="frictionless=True"):
-        Exact(points=POINTS, capacity=np.zeros(3))
+def test_an_exact_model_needs_a_limit_surface():
+    with pytest.raises(InvalidArgumentError, match=r"ls must be a fixplan\.LimitSurface"):
+        Exact(surface=pressure.points(POINTS, CAPACITY))
 
 
 @pytest.mark.parametrize(
@@ -217,7 +219,7 @@ COMPARED = {
     "cone": Cone.from_limit_surface,
     "pyramid": Pyramid.from_limit_surface,
     "point-cone": PointCone.from_limit_surface,
-    "exact": lambda ls: Exact.from_limit_surface(ls, order=4),
+    "exact": Exact.from_limit_surface,
 }
 
 

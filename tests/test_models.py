@@ -339,48 +339,75 @@ def test_point_models_built_from_a_surface_keep_its_friction(disk):
 # -- Exact -------------------------------------------------------------------------------------
 
 
-def test_exact_model_reports_a_quadrature_error_that_falls_with_the_order(disk):
-    errors = [Exact.from_limit_surface(disk, order=k).quadrature_error for k in (4, 8, 16)]
-    assert errors[0] > errors[1] > errors[2]
-    assert errors[1] < 1.5e-3
-    accuracy = compare(Exact.from_limit_surface(disk, order=8), disk, n=256)
-    assert max(accuracy.max_overestimate, accuracy.max_underestimate) == pytest.approx(
-        errors[1], rel=1e-6
-    )
+@pytest.mark.parametrize(
+    "ls",
+    [
+        LimitSurface(pressure.disk(0.01), mu=MU, normal_force=N),
+        LimitSurface(pressure.rectangle(0.1, 0.01), mu=MU, normal_force=N),
+        LimitSurface(pressure.points([[0.0, 0.0], [0.04, 0.0], [0.0, 0.02]], [1, 2, 3]), mu=MU),
+        LimitSurface(pressure.points([[0, 0], [0.02, 0], [0, 0.02]]), mu=lambda x, y: 0.3 + 10 * x),
+        LimitSurface.combine(
+            [
+                LimitSurface(pressure.disk(0.005).shifted(-0.03, 0.0), mu=0.4, normal_force=1.0),
+                LimitSurface(pressure.disk(0.005).shifted(0.03, 0.0), mu=0.6, normal_force=3.0),
+            ]
+        ),
+    ],
+    ids=["disk", "rectangle", "points", "varying-mu", "combined"],
+)
+def test_exact_model_is_the_exact_surface(ls):
+    model = Exact.from_limit_surface(ls)
+    assert model.mu == pytest.approx(ls.max_force / ls.normal_force, rel=1e-15)
+    units = np.array([ls.max_force, ls.max_force, ls.max_moment])
+    loads = np.random.default_rng(6).normal(size=(50, 3)) * units
+    np.testing.assert_allclose(model.safety_factor(loads), ls.safety_factor(loads), rtol=1e-12)
+    motion = model.motion(loads)
+    exact = ls.motion(loads)
+    np.testing.assert_allclose(motion / np.linalg.norm(motion, axis=1, keepdims=True),
+                               exact / np.linalg.norm(exact, axis=1, keepdims=True), atol=1e-12)  # fmt: skip
 
 
-def test_exact_model_of_point_supports_is_exact(skewed):
+def test_exact_model_cut_is_the_tangent_plane_at_the_load_and_holds_the_surface(disk):
+    model = Exact.from_limit_surface(disk)
+    units = np.array([MU, MU, MU * model.rho])  # the set per unit normal force
+    loads = np.random.default_rng(8).normal(size=(40, 3)) * units
+    planes, excess = model.cut(loads)
+    safety = disk.safety_factor(loads * N)
+    np.testing.assert_allclose(excess, 1.0 / safety - 1.0, rtol=1e-12)
+    # The plane a · L <= 1 touches the surface at the load's ray ...
+    touching = loads * safety[:, None]
+    np.testing.assert_allclose(np.einsum("ij,ij->i", planes, touching), 1.0, rtol=1e-12)
+    # ... and holds every load of the surface.
+    surface = disk.sample(500) / N
+    assert np.max(surface @ planes.T) <= 1.0 + 1e-12
+
+
+def test_exact_model_of_point_supports_cuts_along_the_facets(skewed):
+    # A load whose centre of rotation is a support point lies on a facet: the cut is the facet.
     model = Exact.from_limit_surface(skewed)
-    assert model.quadrature_error < 1e-13
-    loads = np.random.default_rng(6).normal(size=(50, 3)) * [1.0, 1.0, 0.02]
-    np.testing.assert_allclose(model.safety_factor(loads), skewed.safety_factor(loads), 1e-10)
+    xy = skewed.field.pose.apply(skewed.field.xy)[1]
+    facet_twist = np.array([xy[1], -xy[0], 1.0])
+    on_facet = skewed.load(facet_twist) / N
+    planes, excess = model.cut(on_facet[None, :] * 1.5)
+    assert excess[0] == pytest.approx(0.5, rel=1e-12)
+    expected = facet_twist / (skewed.support(facet_twist) / N)
+    np.testing.assert_allclose(planes[0], expected, rtol=1e-9)
 
 
-def test_exact_model_constraints_state_the_discretised_surface(disk):
-    model = Exact.from_limit_surface(disk, order=6)
+def test_exact_model_constraints_state_an_outer_polytope_of_tangent_planes(disk):
+    model = Exact.from_limit_surface(disk)
+    assert 0.0 < model.constraint_error < 0.5
     load = cp.Parameter(3)
     fn = cp.Variable()
     problem = cp.Problem(cp.Minimize(fn), model.constraints(load, fn))
     assert problem.is_dcp(dpp=True)
-    for probe in ([0.5, 0.2, 0.003], [0.0, 0.0, 0.01], [1.0, 0.0, 0.0]):
-        load.value = np.array(probe)
+    ratios = []
+    for probe in disk.sample(60):
+        load.value = probe
         problem.solve(solver=cp.CLARABEL)
-        # model.surface is the set at unit normal force: L is held from fn = 1 / s(L) on.
-        expected = 1.0 / model.surface.safety_factor(np.array(probe))
-        assert fn.value == pytest.approx(expected, rel=1e-6)
-
-
-def test_exact_model_handles_position_dependent_friction_and_combined_surfaces():
-    field = pressure.points([[0.0, 0.0], [0.02, 0.0], [0.0, 0.02]])
-    varying = LimitSurface(field, mu=lambda x, y: 0.3 + 10.0 * x, normal_force=2.0)
-    model = Exact.from_limit_surface(varying)
-    assert model.quadrature_error < 1e-12
-    left = LimitSurface(pressure.disk(0.005).shifted(-0.03, 0.0), mu=0.4, normal_force=1.0)
-    right = LimitSurface(pressure.disk(0.005).shifted(0.03, 0.0), mu=0.6, normal_force=3.0)
-    combined = LimitSurface.combine([left, right])
-    model = Exact.from_limit_surface(combined, order=6)
-    assert model.mu == pytest.approx((0.4 * 1.0 + 0.6 * 3.0) / 4.0, rel=1e-12)
-    assert model.quadrature_error < 2e-3
+        ratios.append(fn.value / N)  # probe is on the surface at N: the polytope needs less
+    assert min(ratios) >= 1.0 / (1.0 + model.constraint_error) - 1e-7
+    assert max(ratios) <= 1.0 + 1e-7
 
 
 # -- frames whose origin is not the centre of pressure --------------------------------------------
@@ -461,8 +488,8 @@ def test_models_refuse_bad_parameters_naming_them(disk):
         Ellipsoid.from_limit_surface(disk).safety_factor([1.0, 0.0, 0.0], normal_force=0.0)
     with pytest.raises(InvalidArgumentError, match=r"ls must be a fixplan\.LimitSurface"):
         Cone.from_limit_surface(pressure.disk(0.01))
-    with pytest.raises(InvalidArgumentError, match="order must be a positive integer"):
-        Exact.from_limit_surface(disk, order=0)
+    with pytest.raises(InvalidArgumentError, match=r"ls must be a fixplan\.LimitSurface"):
+        Exact.from_limit_surface(pressure.disk(0.01))
     with pytest.raises(InvalidArgumentError, match="only section is 'fx-fy'"):
         PointCone(mu=1.0).curve("fy-m")
 

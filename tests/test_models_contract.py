@@ -60,7 +60,7 @@ FACTORIES = {
     "point-pyramid-8-circumscribed": lambda ls: PointPyramid.from_limit_surface(
         ls, facets=8, inscribed=False
     ),
-    "exact": lambda ls: Exact.from_limit_surface(ls, order=4),
+    "exact": Exact.from_limit_surface,
     "polytope-64-inscribed": lambda ls: Polytope.from_limit_surface(ls, cuts=64),
     "polytope-64-outside": lambda ls: Polytope.from_limit_surface(ls, cuts=64, inscribed=False),
 }
@@ -218,13 +218,15 @@ def _feasibility_problem(m: FrictionModel):
 
 @pytest.mark.parametrize(("name", "field"), CASES)
 def test_constraints_are_convex_dpp_and_agree_with_contains(name, field):
+    # Models whose constraints overestimate their set (the exact model's seed polytope) are
+    # probed beyond their constraint_error.
     m = model(name, field)
     problem, target, force = _feasibility_problem(m)
     assert problem.is_dcp(dpp=True)
     loads = loads_for(m, 4, seed=4)
     safety = m.safety_factor(loads)
     for load, s in zip(loads, safety, strict=True):
-        for factor in (0.97, 1.03):
+        for factor in (0.97, 1.03 * (1.0 + m.constraint_error)):
             probe = load * s * factor
             target.value = probe[: m.load_dimension]
             force.value = m.normal_force
@@ -237,7 +239,7 @@ def test_constraints_are_convex_dpp_and_agree_with_contains(name, field):
 @pytest.mark.parametrize(("name", "field"), CASES)
 def test_smallest_normal_force_in_the_constraints_matches_the_safety_factor(name, field):
     # Homogeneity in the normal force: with fn a variable, the least fn that holds L is
-    # N / s(L, N).
+    # N / s(L, N) (down to that over 1 + constraint_error for an outer polytope).
     m = model(name, field)
     load = cp.Parameter(m.load_dimension)
     fn = cp.Variable(nonneg=True)
@@ -247,7 +249,8 @@ def test_smallest_normal_force_in_the_constraints_matches_the_safety_factor(name
         load.value = probe[: m.load_dimension]
         problem.solve(solver=cp.CLARABEL)
         expected = m.normal_force / m.safety_factor(probe)
-        assert fn.value == pytest.approx(expected, rel=1e-6)
+        low = expected / (1.0 + m.constraint_error)
+        assert low * (1.0 - 1e-6) <= fn.value <= expected * (1.0 + 1e-6)
 
 
 @pytest.mark.parametrize(("name", "field"), CASES)

@@ -114,7 +114,7 @@ from fixplan.io.toml_schema import (
     read_regular_file,
 )
 from fixplan.motion import Fit, FittedQuartic, Stiffness
-from fixplan.planner.contact_models import PLANNER_EXACT_ORDER, contact_model
+from fixplan.planner.contact_models import contact_model
 from fixplan.planner.problem import (
     AREA_MODEL_NAMES,
     COMPLIANT_OBJECTIVE,
@@ -127,10 +127,8 @@ from fixplan.planner.problem import (
     Load,
     Problem,
 )
-from fixplan.surface import pressure
 from fixplan.tolerances import (
     MAX_ACCELERATION,
-    MAX_EXACT_POINTS,
     MAX_FACETS,
     MAX_FORCE,
     MAX_LENGTH,
@@ -481,8 +479,6 @@ class _Reader:
                 "patch (the normal force acts at position)",
             )
         patch, patch_axis = read_patch(table, folder=self.folder)
-        if model == "exact" and patch is not None:
-            _check_exact_size(table, patch)
         if model in AREA_MODEL_NAMES and "patch" not in table.data:
             self._report_missing_patch(table, model, name)
         axis = _contact_axis(table, patch_axis)
@@ -574,19 +570,6 @@ def _stiffness(table: Table) -> Stiffness | None:
     if springs is None:
         return None
     return springs.read(Stiffness, _STIFFNESS_KINDS, required=("normal", "tangential"))
-
-
-def _check_exact_size(table: Table, patch: pressure.PressureField) -> None:
-    """Report a patch too fine for the planner's exact model (its cost grows with the number
-    of friction disks)."""
-    disks = len(patch.quadrature(PLANNER_EXACT_ORDER)[0])
-    if disks > MAX_EXACT_POINTS:
-        table.report(
-            "patch",
-            f"the exact model would split this patch into {disks} friction disks, more than "
-            f"the {MAX_EXACT_POINTS} accepted; give fewer vertices, points or grid cells, or "
-            "use another model",
-        )
 
 
 def _fitted_mu(table: Table, fit_mu: float) -> float | None:

@@ -18,7 +18,7 @@ model                         torsion     motion  conservative  cvxpy form
 :class:`Pyramid`              yes         no      if inscribed  ``2k`` linear inequalities
 :class:`PointCone`            no          yes     yes           one second-order cone
 :class:`PointPyramid`         no          no      if inscribed  ``k`` linear inequalities
-:class:`Exact`                yes         yes     no (±quad.)   one small cone per point
+:class:`Exact`                yes         yes     yes (exact)   tangent planes; cuts in planner
 :class:`Polytope`             yes         yes     if inscribed  ``2k`` linear inequalities
 ============================  ==========  ======  ============  ===========================
 

@@ -134,6 +134,13 @@ class FrictionModel(ConvexForm, ABC):
         return moved
 
     @property
+    def constraint_error(self) -> float:
+        """Largest relative radial gap by which :meth:`constraints` overestimate the model's set
+        [-]: 0 when they state it exactly (the exact model states an outer polytope that the
+        planner refines with cuts)."""
+        return 0.0
+
+    @property
     def has_motion(self) -> bool:
         """Whether :meth:`motion` is defined (the normals of the set give the sliding twist)."""
         return type(self)._normal is not FrictionModel._normal

@@ -1,212 +1,155 @@
-r"""The exact limit surface as a friction model that cvxpy can use.
+r"""The exact limit surface as a friction model: the engine's own set, stated by tangent planes.
 
-The pressure field is discretised by its quadrature rule into points ``x_j`` carrying the
-fractions ``w_j`` of the normal force. Each point holds a friction force inside its own disk,
-and the contact holds the resultant:
+The limit set of a contact at normal force ``N`` is, by definition,
 
-.. math::
-    \|f_j\| \le \mu_j w_j N, \qquad
-    L = \Big(\sum_j f_j,\; \sum_j x_j \times f_j\Big).
+.. math:: \{L : L \cdot V \le N\, h_1(V) \ \text{for all twists } V\},
 
-This is exactly the limit surface of the point set (the Minkowski sum of the points' disks,
-paper §4.1), so the numeric methods use that surface (:attr:`Exact.surface`) and agree with
-the constraints to solver accuracy. It differs from the exact surface of the continuous field
-by the quadrature error, which the model measures when it is built
-(:attr:`Exact.quadrature_error`). The error has both signs, so the model is not conservative.
+with ``h_1`` the support function at unit normal force. The numeric methods (containment,
+safety factor, motion) ask the exact engine (:class:`~fixplan.LimitSurface`) directly, so they
+are exact to its accuracy (about 1e-13 for the closed-form fields, facets of point supports
+included). As convex constraints the set is an intersection of infinitely many halfspaces, so
+the model states a finite subset of them: the tangent planes at ``SEED_PLANES`` evenly spread
+twists (:meth:`Exact.conic_form`, an outer polytope, homogeneous in ``N``), and :meth:`Exact.cut`
+gives the tangent plane at the ray of any load, the cut that removes that load when it lies
+outside. The planner adds such cuts until every contact load lies inside its exact surface
+(:mod:`fixplan.planner.cuts`); used on its own, :meth:`constraints` states the seed polytope
+only, which holds the exact set (:attr:`Exact.constraint_error` says by how much).
 
-A frictionless contact keeps the per-point capacities of its shape (``mu = 1``) with
-``frictionless=True``: its set is the load 0 and its motion the limit ``mu → 0+``
-(:mod:`fixplan.models.base`).
+A frictionless contact keeps the shape of its patch (:attr:`LimitSurface.friction_shape`):
+its set is the load 0 and its motion the limit ``mu → 0+`` (:mod:`fixplan.models.base`).
 """
 
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
-from fixplan import validation
-from fixplan.errors import InvalidArgumentError
 from fixplan.models.base import FrictionModel, fmt
 from fixplan.models.conic import unit_conic
+from fixplan.models.ellipsoid import surface_units
 from fixplan.surface.sphere import fibonacci_sphere
 
 if TYPE_CHECKING:  # pragma: no cover
     from fixplan.surface.limit_surface import LimitSurface
 
-#: Default quadrature order (Gauss nodes per dimension and panel): 128 points on a disk or a
-#: rectangle, a radial error of about 1e-3 (the tests measure it).
-DEFAULT_ORDER = 8
-
-#: Number of evenly spread load directions on which the quadrature error is measured.
-ERROR_DIRECTIONS = 256
+#: Tangent planes of the seed polytope (mirror pairs of a Fibonacci lattice of twists in
+#: normalised coordinates). More planes: fewer cutting rounds in the planner, larger problems.
+SEED_PLANES = 24
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, repr=False, eq=False)
 class Exact(FrictionModel):
-    """The limit surface of a pressure field discretised into per-point friction disks.
+    """The exact limit surface of a contact, as a friction model.
 
     Attributes
     ----------
-    points : numpy.ndarray
-        Quadrature points ``(n, 2)`` [m] in the contact frame.
-    capacity : numpy.ndarray
-        Friction force of each point per unit normal force, ``mu_j w_j`` ``(n,)`` [-]; of a
-        frictionless model, that of its shape (``w_j``: ``mu = 1``).
-    frictionless : bool
-        Whether the contact has no friction (``mu = 0``); ``capacity`` then gives only the
-        shape, used by :meth:`motion`.
-    normal_force : float
-        Default normal force of the numeric methods [N].
-    quadrature_error : float
-        Largest relative radial gap to the exact surface over ``ERROR_DIRECTIONS`` load
-        directions (``nan`` when not measured, e.g. built directly from points).
-    order : int or None
-        Quadrature order the points came from.
+    surface : LimitSurface
+        The contact's exact limit surface; its normal force is the model's default
+        ``normal_force`` [N]. Moments are about its frame origin.
     """
 
-    points: np.ndarray
-    capacity: np.ndarray
-    frictionless: bool = False
-    normal_force: float = 1.0
-    quadrature_error: float = float("nan")
-    order: int | None = None
-    _surface: LimitSurface = field(init=False)
+    surface: LimitSurface
+    _seed: np.ndarray = dataclasses.field(init=False)
 
-    conservative: ClassVar[bool] = False
+    conservative: ClassVar[bool] = True
 
     def __post_init__(self):
-        from fixplan.surface import pressure
-        from fixplan.surface.limit_surface import LimitSurface
-
-        points = validation.finite_array("points", self.points, shape=(None, 2))
-        capacity = validation.finite_array("capacity", self.capacity, shape=(len(points),))
-        if np.any(capacity < 0.0):
-            raise InvalidArgumentError(f"capacity must be >= 0, got {capacity.min()!r}")
-        if not np.any(capacity > 0.0):
-            raise InvalidArgumentError(
-                "capacity must have a positive entry; for a frictionless contact pass "
-                "frictionless=True with the capacity of its shape (the force fractions w_j)"
-            )
-        normal_force = validation.positive_scalar("normal_force", self.normal_force)
-        loaded = capacity > 0.0
-        points, capacity = points[loaded], capacity[loaded]
-        points.setflags(write=False)
-        capacity.setflags(write=False)
-        field_ = pressure.points(points, capacity, centered=False)
-        surface = LimitSurface(field_, mu=float(capacity.sum()), normal_force=1.0)
-        object.__setattr__(self, "points", points)
-        object.__setattr__(self, "capacity", capacity)
-        object.__setattr__(self, "frictionless", bool(self.frictionless))
-        object.__setattr__(self, "normal_force", normal_force)
-        object.__setattr__(self, "quadrature_error", float(self.quadrature_error))
-        object.__setattr__(self, "_surface", surface)
+        surface_units(self.surface)  # checks the type
+        directions = fibonacci_sphere(SEED_PLANES)[: SEED_PLANES // 2]
+        shape = self.surface.friction_shape
+        # A twist d in normalised coordinates is the load-space twist d / units; its plane is
+        # d · q <= h_1(d / units) N.
+        support = shape.support(directions / self._units()) / self.surface.normal_force
+        seed = np.vstack([directions, -directions]) / np.concatenate([support, support])[:, None]
+        seed.setflags(write=False)
+        object.__setattr__(self, "_seed", seed)
 
     @classmethod
-    def from_limit_surface(cls, ls: LimitSurface, *, order: int = DEFAULT_ORDER) -> Exact:
-        """Discretise the field of ``ls`` with ``field.quadrature(order)`` and measure the error.
-
-        Works for constant and position-dependent ``mu``, for combined surfaces (the
-        quadrature points of every part, weighted by its share of the normal force) and for
-        frictionless surfaces (the points of the shape, ``frictionless=True``; the error is
-        that of the shape).
-        """
-        from fixplan.models.ellipsoid import surface_units
-
-        surface_units(ls)
-        if isinstance(order, bool) or not isinstance(order, int | np.integer) or order < 1:
-            raise InvalidArgumentError(f"order must be a positive integer, got {order!r}")
-        shape = ls.friction_shape
-        points, capacity = _discretise(shape, int(order))
-        model = cls(
-            points=points,
-            capacity=capacity,
-            frictionless=ls.frictionless,
-            normal_force=ls.normal_force,
-            order=int(order),
-        )
-        units = np.array([shape.max_force, shape.max_force, shape.max_moment])
-        loads = fibonacci_sphere(ERROR_DIRECTIONS) * units
-        approx = model.friction_shape.safety_factor(loads)
-        error = np.max(np.abs(approx / shape.safety_factor(loads) - 1.0))
-        object.__setattr__(model, "quadrature_error", float(error))
-        return model
-
-    @property
-    def surface(self) -> LimitSurface:
-        """Limit surface of the point set at unit normal force: the set the constraints state
-        (of the shape for a frictionless model, whose set is the load 0)."""
-        return self._surface
+    def from_limit_surface(cls, ls: LimitSurface) -> Exact:
+        """The exact model of ``ls`` (constant or position-dependent ``mu``, combined surfaces,
+        frictionless surfaces)."""
+        return cls(surface=ls)
 
     @property
     def mu(self) -> float:
-        return 0.0 if self.frictionless else self._shape_mu
+        """Largest friction force per unit normal force [-] (0 when frictionless)."""
+        return self.surface.max_force / self.surface.normal_force
 
     @property
-    def _shape_mu(self) -> float:
-        return float(self.capacity.sum())
-
-    def _with_shape_friction(self) -> Exact:
-        return dataclasses.replace(self, frictionless=False)
+    def normal_force(self) -> float:
+        """Default normal force of the numeric methods [N]: that of :attr:`surface`."""
+        return self.surface.normal_force
 
     @property
     def rho(self) -> float:
-        return self._surface.characteristic_length
+        return self.surface.characteristic_length
 
-    def _surface_loads(self, q):
-        """Loads of the surface along ``q``, scaled to unit size, and the scales."""
-        size = np.abs(q).max(axis=1)
-        size = np.where(size > 0.0, size, 1.0)
-        return q / size[:, None] * self._units()[None, :], size
+    @property
+    def _shape_mu(self) -> float:
+        shape = self.surface.friction_shape
+        return shape.max_force / shape.normal_force
+
+    def _with_shape_friction(self) -> Exact:
+        return Exact(surface=self.surface.friction_shape)
+
+    @property
+    def constraint_error(self) -> float:
+        """Largest relative radial gap of the seed polytope (:meth:`constraints`) to the exact
+        surface [-], read at the polytope's vertices (the polytope holds the surface)."""
+        from scipy.spatial import ConvexHull
+
+        hull = ConvexHull(self._seed)
+        vertices = hull.equations[:, :3] / -hull.equations[:, 3:]
+        return float(np.max(self.friction_shape._gauge(vertices)) - 1.0)
+
+    def cut(self, loads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        r"""The tangent plane of the exact set at the ray of each load, and the loads' excess.
+
+        Parameters
+        ----------
+        loads : numpy.ndarray
+            ``(K, 3)`` loads ``(fx, fy, m)`` per unit normal force [-, -, m], nonzero.
+
+        Returns
+        -------
+        planes : numpy.ndarray
+            ``(K, 3)`` rows ``a`` [-, -, 1/m] with the plane :math:`a \cdot L \le N` for loads
+            ``L`` [N, N, N m] at normal force ``N`` [N]:
+            ``a = V / h_1(V)`` for the sliding twist ``V`` of the load (a facet's own plane
+            for a load beyond a facet of point supports).
+        excess : numpy.ndarray
+            ``(K,)`` ``1 / s - 1`` for the exact safety factor ``s`` of each load at unit
+            normal force: positive outside the set.
+        """
+        twists, safety = self.surface.motion_and_safety_factor(loads * self.surface.normal_force)
+        return self.planes(np.atleast_2d(twists)), 1.0 / np.atleast_1d(safety) - 1.0
+
+    def planes(self, twists: np.ndarray) -> np.ndarray:
+        r"""Tangent planes :math:`a \cdot L \le N`, ``a = V / h_1(V)``, of the exact set at the
+        nonzero twists ``V`` ``(K, 3)``; ``a`` ``(K, 3)``."""
+        support = np.atleast_1d(self.surface.support(twists)) / self.surface.normal_force
+        return twists / support[:, None]
+
+    def _loads(self, q):
+        """Loads at the surface's normal force along the normalised loads ``q``."""
+        return q * self._units() * self.surface.normal_force
 
     def _gauge(self, q):
-        loads, size = self._surface_loads(q)
-        return size / self._surface.safety_factor(loads)
+        return 1.0 / np.atleast_1d(self.surface.safety_factor(self._loads(q)))
 
     def _normal(self, q):
-        loads, _ = self._surface_loads(q)
-        return self._surface.motion(loads) * np.array([1.0, 1.0, self.rho])
+        twists = np.atleast_2d(self.surface.friction_shape.motion(self._loads(q)))
+        return twists * self._units()
 
     def _unit_conic(self):
-        # Auxiliary variables: the point forces z = (f_1, ..., f_n), f_j = (fx_j, fy_j).
-        # Rows: q - resultant(z) / units = 0, then (capacity_j N, f_j) in a cone per point.
-        x, y = self.points[:, 0], self.points[:, 1]
-        count = len(self.capacity)
-        resultant = np.zeros((3, 2 * count))
-        resultant[0, 0::2] = 1.0
-        resultant[1, 1::2] = 1.0
-        resultant[2, 0::2], resultant[2, 1::2] = -y, x
-        normal = np.zeros(3 + 3 * count)
-        normal[3::3] = self.capacity
-        q = np.zeros((3 + 3 * count, 3))
-        q[:3] = np.eye(3)
-        aux = np.zeros((3 + 3 * count, 2 * count))
-        aux[:3] = -resultant / self._units()[:, None]
-        aux[4::3, 0::2] = np.eye(count)
-        aux[5::3, 1::2] = np.eye(count)
-        return unit_conic(normal, q, aux, cones=[("zero", 3)] + [("soc", 3)] * count)
+        count = len(self._seed)
+        return unit_conic(np.ones(count), -self._seed, cones=[("nonneg", count)])
 
     def __repr__(self) -> str:
-        order = "" if self.order is None else f", order={self.order}"
         return (
-            f"Exact({len(self.points)} points{order}, mu={fmt(self.mu)}, rho={fmt(self.rho)} m, "
-            f"quadrature_error={self.quadrature_error:.2g}, "
+            f"Exact({self.surface!r}, mu={fmt(self.mu)}, rho={fmt(self.rho)} m, "
             f"normal_force={fmt(self.normal_force)} N)"
         )
-
-
-def _discretise(ls: LimitSurface, order: int) -> tuple[np.ndarray, np.ndarray]:
-    """Points and friction per unit normal force of the surface ``ls``."""
-    if ls.parts:
-        pieces = [_discretise(part, order) for part in ls.parts]
-        shares = [part.normal_force / ls.normal_force for part in ls.parts]
-        points = np.concatenate([p for p, _ in pieces])
-        capacity = np.concatenate([c * s for (_, c), s in zip(pieces, shares, strict=True)])
-        return points, capacity
-    from fixplan.surface.pressure import friction_values
-
-    points, weights = ls.field.quadrature(order)
-    friction = friction_values(ls.mu, points) if callable(ls.mu) else ls.mu
-    return np.asarray(points), np.asarray(weights * friction)

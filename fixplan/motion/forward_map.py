@@ -7,8 +7,7 @@ closed form, its support function being that of the ellipsoid,
 
 .. math:: h(V) = N \sqrt{V^T A^{-1} V}, \qquad \nabla h(V) = \frac{N A^{-1} V}{\sqrt{V^T A^{-1} V}},
 
-and the :class:`~fixplan.models.Exact` model is the limit surface of its points scaled by its
-normal force. Loads ``(fx, fy, m)`` [N, N, N m] and twists ``(vx, vy, w)`` are about the
+and the :class:`~fixplan.models.Exact` model is its exact limit surface. Loads ``(fx, fy, m)`` [N, N, N m] and twists ``(vx, vy, w)`` are about the
 surface's frame origin (docs/conventions.md).
 """
 
@@ -61,12 +60,7 @@ def forward_map(surface) -> ForwardMap:
         return _ellipsoid(np.linalg.inv(surface.load_matrix), surface.normal_force,
                           surface.safety_factor)  # fmt: skip
     if isinstance(surface, Exact):
-        points, scale = surface.surface, surface.normal_force
-        return ForwardMap(
-            support=lambda twist: scale * points.support(twist),
-            load=lambda twist: scale * points.load(twist),
-            safety_factor=surface.safety_factor,
-        )
+        surface = surface.surface
     if all(hasattr(surface, name) for name in ("support", "load", "safety_factor")):
         return ForwardMap(support=surface.support, load=surface.load,
                           safety_factor=surface.safety_factor)  # fmt: skip

@@ -11,10 +11,6 @@ from fixplan.models.base import FrictionModel
 from fixplan.planner.problem import DEFAULT_FACETS, DEFAULT_INSCRIBED, Contact
 from fixplan.surface.limit_surface import LimitSurface
 
-#: Quadrature order of the "exact" model in the planner: 128 friction disks per disk or
-#: rectangle patch, about 1e-3 from the continuous surface (reported by the model).
-PLANNER_EXACT_ORDER = 8
-
 
 def contact_model(contact: Contact) -> FrictionModel:
     """The friction model of ``contact`` for unit normal force."""
@@ -34,4 +30,4 @@ def contact_model(contact: Contact) -> FrictionModel:
         return Cone.from_limit_surface(surface)
     if model == "pyramid":
         return Pyramid.from_limit_surface(surface, facets=facets, inscribed=inscribed)
-    return Exact.from_limit_surface(surface, order=PLANNER_EXACT_ORDER)
+    return Exact.from_limit_surface(surface)

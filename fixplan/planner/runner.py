@@ -148,14 +148,14 @@ class Runner:
             return direct
         notes = []
         solver = self.solver
-        status = _call(stacked.problem, solver, accurate=accurate)
+        status = _solve(stacked, solver, accurate, notes)
         if status == "optimal":
             self._prepare_direct(objective, stacked)
         if status in ("solver-error", "inaccurate"):
             fallback = _FALLBACK[solver]
             notes.append(f"{solver} returned {status}; retried with {fallback}")
             solver = fallback
-            status = _call(stacked.problem, solver)
+            status = _solve(stacked, solver, False, notes)
         result = {"status": status, "solver": solver, "warnings": notes}
         if status in ("optimal", "inaccurate"):
             result.update(_values(stacked))
@@ -184,6 +184,8 @@ class Runner:
         """
         if self.solver != "CLARABEL":
             return
+        if stacked.cuts is not None:  # the cuts move the conic data A
+            return
         if objective in self._direct or stacked.problem.status != cp.OPTIMAL:
             return
         if not _uses_dpp(stacked.problem):
@@ -207,6 +209,18 @@ def _uses_dpp(problem: cp.Problem) -> bool:
     """Whether ``problem`` is small enough for DPP to pay (see ``DPP_MAX_WORK``)."""
     entries = sum(parameter.size for parameter in problem.parameters())
     return problem.size_metrics.num_scalar_variables * max(entries, 1) <= DPP_MAX_WORK
+
+
+def _solve(stacked: Stacked, solver: str, accurate: bool, notes: list) -> str:
+    """Solve ``stacked``, with rounds of cuts for its exact contacts; notes are appended."""
+    status = _call(stacked.problem, solver, accurate=accurate)
+    if stacked.cuts is None:
+        return status
+    status, more = stacked.cuts.converge(
+        lambda: _call(stacked.problem, solver, accurate=accurate), status
+    )
+    notes.extend(more)
+    return status
 
 
 def _call(problem: cp.Problem, solver: str, *, accurate: bool = False) -> str:

@@ -25,6 +25,7 @@ import scipy.sparse as sp
 
 from fixplan.models.base import FrictionModel
 from fixplan.models.conic import ConicForm, soc_columns
+from fixplan.planner.cuts import CutPool
 from fixplan.planner.objectives import objective_expression
 from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, PASSIVE_ROLES, Problem
 from fixplan.tolerances import MAX_SAFETY_FACTOR
@@ -53,6 +54,8 @@ class ContactLayout:
     signed : numpy.ndarray
         ``(C,)`` bool: the friction set does not imply a nonnegative normal force (a
         frictionless contact), so the planner states it.
+    models : tuple of FrictionModel
+        The friction model of each contact (exact models get cuts, :mod:`fixplan.planner.cuts`).
     """
 
     normal_map: np.ndarray
@@ -61,6 +64,7 @@ class ContactLayout:
     cones: dict
     aux_size: int
     signed: np.ndarray
+    models: tuple[FrictionModel, ...]
 
     @classmethod
     def of(cls, problem: Problem, models: list[FrictionModel]) -> ContactLayout:
@@ -80,6 +84,7 @@ class ContactLayout:
             cones=_stack_cones(forms, starts, aux_starts),
             aux_size=int(aux_starts[-1]),
             signed=np.array([not form.bounds_normal for form in forms]),
+            models=tuple(models),
         )
 
 
@@ -145,6 +150,8 @@ class Stacked:
     decided : numpy.ndarray
         ``(C,)`` bool: the contact's normal force is a decision variable (passive, or an active
         contact whose force is free in this objective).
+    cuts : CutPool or None
+        The tangent-plane cuts of the exact contacts (``None`` without exact models).
     """
 
     problem: cp.Problem
@@ -161,6 +168,7 @@ class Stacked:
     scale: cp.Expression
     balance: cp.Constraint
     decided: np.ndarray
+    cuts: CutPool | None
 
 
 def build(
@@ -248,6 +256,9 @@ def build(
             limits = np.asarray(limits)
             variable = pieces[key][list(rows)]
             constraints.append(variable <= (limits[:, None] if key == "finger" else limits))
+    cuts = CutPool.of(layout.models, layout.slices, normal, friction)
+    if cuts is not None:
+        constraints.append(cuts.constraint)
     unloaded = None
     if squeeze and groups["passive"]:
         unloaded = cp.Parameter((len(groups["passive"]), cases), nonneg=True, name="unloaded")
@@ -285,6 +296,7 @@ def build(
         scale=scale,
         balance=balance,
         decided=decided,
+        cuts=cuts,
     )
 
 

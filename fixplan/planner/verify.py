@@ -33,7 +33,13 @@ def verify(
     friction_part = layout.friction_map @ friction
     task_part = wrenches * scale[None, :]
     residual = normal_part + friction_part + task_part + gravity
-    magnitude = np.abs(normal_part) + np.abs(friction_part) + np.abs(task_part) + np.abs(gravity)
+    # The size of every term, not of their sums: opposed contacts cancel in the sums.
+    magnitude = (
+        np.abs(layout.normal_map) @ np.abs(normal)
+        + np.abs(layout.friction_map) @ np.abs(friction)
+        + np.abs(task_part)
+        + np.abs(gravity)
+    )
     force_size = np.maximum(magnitude[:3].max(axis=0), 1e-12)
     moment_size = np.maximum(magnitude[3:].max(axis=0), force_size * length_scale)
     relative = 0.0

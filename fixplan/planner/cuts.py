@@ -1,0 +1,164 @@
+r"""Exact friction models in the planner: tangent-plane cuts added until every load is inside.
+
+The set of an :class:`~fixplan.models.Exact` model is the intersection of the halfspaces
+``L · V <= N h_1(V)`` over all twists ``V``. Its constraints state a seed polytope of such planes
+(an outer approximation); a solve then gives contact loads ``ℓ_ij`` at normal forces ``n_ij``
+that may lie outside the exact set. For each of those, the tangent plane at the load's ray,
+
+.. math:: a_{ij} \cdot \ell \le n, \qquad a_{ij} = V^*_{ij} / h_1(V^*_{ij}),
+
+with ``V*`` the load's sliding twist from the exact inverse map, cuts it off, and the problem is
+re-solved, until every contact load is inside its exact surface to ``EXACT_CUT_RTOL``. Every cut
+is valid for the exact set, so each solve is a relaxation of the exact problem: an infeasible
+relaxation proves the exact problem infeasible, and the duals of the last solve (the impending
+motions) are those of the exact problem at its optimum.
+
+The cuts sit in a fixed pool of ``CUT_SLOTS`` rows per (contact, load case), cvxpy Parameters
+``A_k`` (one per load component, DPP), so the problem is compiled once; an empty slot has
+``a = 0`` (the row ``0 <= n``, which the seed implies). A new cut takes the slot whose cut was
+active (tight) longest ago; the pool survives between solves, so a re-solve with nearby loads
+starts from the cuts that were active last time.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import cvxpy as cp
+import numpy as np
+import scipy.sparse as sp
+
+from fixplan.models.exact import Exact
+from fixplan.tolerances import EXACT_CUT_RTOL, FRICTION_SET_RTOL
+
+#: Cut rows per (exact contact, load case) besides the seed polytope.
+CUT_SLOTS = 12
+
+#: Spread of the four planes added around each cut, in normalised twist coordinates, per square
+#: root of the load's excess (the distance to the optimum's normal shrinks like that root).
+SPREAD = 1.0
+
+#: Most solves of one problem while cutting; a problem not converged by then is reported.
+MAX_CUT_ROUNDS = 60
+
+#: Cuts are tightened by this fraction (``a (1 + CUT_MARGIN) · ℓ <= n``) so that the solver's
+#: feasibility error (about 1e-9 of the loads) does not leave a load outside by more than
+#: ``EXACT_CUT_RTOL``; the optimum moves by about this fraction.
+CUT_MARGIN = 1e-8
+
+#: A cut counts as active when its slack is below this fraction of the normal force.
+ACTIVE_RTOL = 1e-7
+
+
+class CutPool:
+    """The cut Parameters of a stacked problem's exact contacts, and the rounds of cutting.
+
+    Parameters
+    ----------
+    models : dict
+        Contact index -> its :class:`~fixplan.models.Exact` model (frictionless ones excluded).
+    slices : tuple of slice
+        Rows of each contact's friction load in the stacked friction variable.
+    normal : cvxpy.Expression
+        ``(C, K)`` normal forces [N].
+    friction : cvxpy.Variable
+        ``(D, K)`` friction loads.
+    """
+
+    def __init__(self, models: dict, slices, normal: cp.Expression, friction: cp.Variable):
+        self._contacts = np.array(sorted(models), dtype=int)
+        self._models = [models[i] for i in self._contacts]
+        self._rows = np.array([np.arange(slices[i].start, slices[i].stop) for i in self._contacts])
+        self._normal, self._friction = normal, friction
+        count, cases = len(self._contacts), friction.shape[1]
+        self._planes = np.zeros((3, CUT_SLOTS, count, cases))
+        self._used = np.full((CUT_SLOTS, count, cases), -1, dtype=np.int64)
+        self._round = 0
+        self._parameters = [
+            cp.Parameter((CUT_SLOTS * count, cases), name=f"cut_{axis}", value=np.zeros(
+                (CUT_SLOTS * count, cases)))
+            for axis in ("fx", "fy", "m")
+        ]  # fmt: skip
+        tile = sp.vstack([sp.eye_array(count)] * CUT_SLOTS, format="csr")
+        lhs = sum(
+            cp.multiply(parameter, tile @ friction[self._rows[:, axis], :])
+            for axis, parameter in enumerate(self._parameters)
+        )
+        self.constraint = lhs <= tile @ normal[self._contacts, :]
+
+    @classmethod
+    def of(cls, models, slices, normal, friction) -> CutPool | None:
+        """The pool of the exact models among ``models`` (one per contact), or ``None``."""
+        exact = {i: m for i, m in enumerate(models) if isinstance(m, Exact) and not m.frictionless}
+        return cls(exact, slices, normal, friction) if exact else None
+
+    def converge(self, solve: Callable[[], str], status: str) -> tuple[str, list[str]]:
+        """Cut and re-solve (``solve()`` returns the status) from a first solve's ``status``
+        until every exact contact load is inside its surface; the final status and notes."""
+        for _ in range(MAX_CUT_ROUNDS):
+            if status not in ("optimal", "inaccurate"):
+                return status, []
+            worst = self.add_cuts()
+            if worst <= EXACT_CUT_RTOL:
+                return status, []
+            status = solve()
+        if status in ("optimal", "inaccurate") and (worst := self.add_cuts()) > EXACT_CUT_RTOL:
+            return status, [
+                f"exact friction models: after {MAX_CUT_ROUNDS} rounds of cuts a contact load "
+                f"still lies {worst:.2g} (relative) outside its limit surface"
+            ]
+        return status, []
+
+    def add_cuts(self) -> float:
+        """Cut off the contact loads of the last solve that lie outside their exact surfaces.
+
+        Returns the largest relative excess ``1 / s - 1`` of a pressed contact's load (before
+        the new cuts; negative when all are inside).
+        """
+        normal = np.asarray(self._normal.value, dtype=float)
+        friction = np.asarray(self._friction.value, dtype=float)
+        forces = normal[self._contacts]  # (E, K)
+        loads = np.moveaxis(friction[self._rows], 1, 0)  # (3, E, K)
+        self._round += 1
+        slack = forces[None] - np.einsum("xpek,xek->pek", self._planes, loads)
+        active = np.any(self._planes != 0.0, axis=0) & (slack <= ACTIVE_RTOL * forces[None])
+        self._used[active] = self._round
+        noise = FRICTION_SET_RTOL * max(float(np.abs(normal).max(initial=0.0)), 1e-300)
+        worst = -np.inf
+        for e, model in enumerate(self._models):
+            cases = np.flatnonzero(forces[e] > noise)
+            per_unit = loads[:, e, cases].T / forces[e, cases, None]
+            moving = np.abs(per_unit).max(axis=1, initial=0.0) > 0.0
+            cases, per_unit = cases[moving], per_unit[moving]
+            if cases.size == 0:
+                continue
+            planes, excess = model.cut(per_unit)
+            worst = max(worst, float(excess.max()))
+            cut = excess > EXACT_CUT_RTOL
+            cases, planes = cases[cut], planes[cut]
+            if cases.size == 0:
+                continue
+            around = _around(planes, model.rho, SPREAD * np.sqrt(excess[cut]))
+            for rows in (planes, *model.planes(around.reshape(-1, 3)).reshape(4, -1, 3)):
+                slots = np.argmin(self._used[:, e, cases], axis=0)
+                self._planes[:, slots, e, cases] = rows.T * (1.0 + CUT_MARGIN)
+                self._used[slots, e, cases] = self._round
+        shape = self._parameters[0].shape
+        for axis, parameter in enumerate(self._parameters):
+            parameter.value = self._planes[axis].reshape(shape)
+        return worst
+
+
+def _around(twists: np.ndarray, rho: float, spread: np.ndarray) -> np.ndarray:
+    """Four twists ``(4, K, 3)`` around each twist of ``twists`` ``(K, 3)``, tilted by ``±spread``
+    along two directions normal to it in normalised coordinates ``(vx, vy, rho w)``."""
+    scale = np.array([1.0, 1.0, rho])
+    unit = twists * scale
+    unit /= np.linalg.norm(unit, axis=1, keepdims=True)
+    helper = np.eye(3)[np.argmin(np.abs(unit), axis=1)]
+    first = np.cross(unit, helper)
+    first /= np.linalg.norm(first, axis=1, keepdims=True)
+    second = np.cross(unit, first)
+    tilt = np.minimum(spread, 0.5)[:, None]
+    around = [unit + tilt * first, unit - tilt * first, unit + tilt * second, unit - tilt * second]
+    return np.array(around) / scale

@@ -1,0 +1,178 @@
+"""The planner with exact friction models, against closed forms of the uniform disk.
+
+Uniform disk of radius ``R``, friction ``mu``, normal force ``N``, centre of rotation at ``u R``
+from the centre (DESIGN.md §4, elliptic integrals of modulus ``k`` as ``ellipe(k**2)``):
+
+- ``u <= 1``: ``|f|/(mu N) = 4/(3πu) [(1+u²)E(u) - (1-u²)K(u)]``,
+  ``|m|/(mu N R) = 4/(9π) [2(2-u²)E(u) - (1-u²)K(u)]``;
+- ``u >= 1``: ``|f|/(mu N) = 4/(3π) [(1+u²)E(1/u) - (u²-1)K(1/u)]``,
+  ``|m|/(mu N R) = 4/(9π) [2u(2-u²)E(1/u) + (u²-1)(2u²-3)/u K(1/u)]``;
+- pure force ``mu N`` (``u → ∞``), pure moment ``(2/3) mu N R`` (``u = 0``).
+
+A load ``(f, m)`` of the disk is on its limit surface at the ``N`` whose curve point has the
+ratio ``m / (f R)``; the root in ``u`` is found with Brent's method on the formulas above, which
+share no code with the library. Optima are compared to 1e-7 relative, and every contact load of
+every plan lies inside its exact surface to 1e-9 (``EXACT_CUT_RTOL``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+from scipy.special import ellipe, ellipk
+
+from fixplan import Body, Contact, LimitSurface, Load, Problem, pressure
+from fixplan.planner.contact_models import contact_model
+from fixplan.planner.planner import Planner
+from fixplan.tolerances import EXACT_CUT_RTOL
+
+R, MU, HALF_GAP = 0.01, 0.5, 0.04
+OPTIMUM_RTOL = 1e-7
+
+
+def disk_curve(u: float) -> tuple[float, float]:
+    """``(|f| / (mu N), |m| / (mu N R))`` of the uniform disk, rotation about ``u R``."""
+    if u == 1.0:
+        return 8.0 / (3.0 * math.pi), 8.0 / (9.0 * math.pi)
+    if u < 1.0:
+        e, k = ellipe(u * u), ellipk(u * u)
+        force = 4.0 / (3.0 * math.pi * u) * ((1 + u * u) * e - (1 - u * u) * k)
+        moment = 4.0 / (9.0 * math.pi) * (2.0 * (2 - u * u) * e - (1 - u * u) * k)
+    else:
+        e, k = ellipe(1.0 / u**2), ellipk(1.0 / u**2)
+        force = 4.0 / (3.0 * math.pi) * ((1 + u * u) * e - (u * u - 1) * k)
+        moment = (
+            4.0
+            / (9.0 * math.pi)
+            * (2 * u * (2 - u * u) * e + (u * u - 1) * (2 * u * u - 3) / u * k)
+        )
+    return force, moment
+
+
+def least_normal_force(force: float, moment: float) -> tuple[float, float]:
+    """The normal force [N] that puts the disk load ``(|f|, |m|)`` on its limit surface, and the
+    ``u`` of its centre of rotation."""
+    if force == 0.0:
+        return abs(moment) / (2.0 / 3.0 * MU * R), 0.0
+    if moment == 0.0:
+        return force / MU, math.inf
+    ratio = abs(moment) / (force * R)
+    u = brentq(lambda u: disk_curve(u)[1] / disk_curve(u)[0] - ratio, 1e-6, 100.0, xtol=1e-15)
+    return force / (MU * disk_curve(u)[0]), u
+
+
+def pinch(load: Load, objective: str = "min-max-normal-force", force=None) -> Problem:
+    """Two fingers with uniform disk patches squeezing a weightless bar along y."""
+    contacts = [
+        Contact(name=name, role="finger", position=[0, side * HALF_GAP, 0], normal=[0, -side, 0],
+                mu=MU, model="exact", patch=pressure.disk(R), force=force)
+        for name, side in (("left", -1), ("right", 1))
+    ]  # fmt: skip
+    return Problem(body=Body(mass=0.0, center_of_mass=[0, 0, 0]), contacts=contacts,
+                   loads=[load], objective=objective)  # fmt: skip
+
+
+def assert_loads_inside_their_exact_surfaces(problem: Problem, plan) -> None:
+    for i, contact in enumerate(problem.contacts):
+        surface = contact_model(contact).surface  # at unit normal force
+        for fn, load in zip(plan.normal_forces[i], plan.contact_wrenches[i, :, 1:], strict=True):
+            if fn > 1e-9 * plan.normal_forces.max():
+                assert 1.0 / surface.safety_factor(load / fn) - 1.0 <= EXACT_CUT_RTOL
+
+
+# (weight along z through the grasp axis [N], torque about the grasp axis y [N m])
+PINCH_LOADS = [(10.0, 0.0), (0.0, 0.4), (10.0, 0.05), (10.0, 0.2), (2.0, 0.4)]
+
+
+@pytest.mark.parametrize(("weight", "torque"), PINCH_LOADS)
+def test_a_uniform_disk_pinch_needs_the_closed_form_grip_force(weight, torque):
+    # Each finger carries half of the weight and half of the torque about its own normal.
+    load = Load(name="hold", force=[0, 0, -weight], point=[0, 0, 0], torque=[0, torque, 0])
+    problem = pinch(load)
+    plan = Planner(problem).solve()
+    expected, _ = least_normal_force(weight / 2.0, torque / 2.0)
+    assert plan.status == "optimal"
+    np.testing.assert_allclose(plan.normal_forces[:, 0], expected, rtol=OPTIMUM_RTOL)
+    assert_loads_inside_their_exact_surfaces(problem, plan)
+    # The analysis of the forces found: held with safety factor 1.
+    assert plan.safety_factor == pytest.approx(1.0, rel=1e-6)
+
+
+@pytest.mark.parametrize(("weight", "torque"), PINCH_LOADS)
+def test_a_uniform_disk_pinch_with_given_forces_has_the_closed_form_safety_factor(weight, torque):
+    grip = 60.0  # [N] per finger
+    load = Load(name="hold", force=[0, 0, -weight], point=[0, 0, 0], torque=[0, torque, 0])
+    problem = pinch(load, "max-safety-factor", force=grip)
+    plan = Planner(problem).solve()
+    # k (f, m) is on the surface at the grip: k = grip / N(f, m), N homogeneous of degree 1.
+    needed, _ = least_normal_force(weight / 2.0, torque / 2.0)
+    assert plan.status == "optimal"
+    assert plan.safety_factor == pytest.approx(grip / needed, rel=OPTIMUM_RTOL)
+    assert_loads_inside_their_exact_surfaces(problem, plan)
+
+
+def plate(push: Load) -> Problem:
+    """A 2 kg plate resting on one uniform disk patch, pushed in the plane."""
+    support = Contact(name="base", role="support", position=[0, 0, 0], normal=[0, 0, 1], mu=MU,
+                      model="exact", patch=pressure.disk(R))  # fmt: skip
+    return Problem(body=Body(mass=2.0, center_of_mass=[0, 0, 0.01]), contacts=[support],
+                   loads=[push], objective="max-safety-factor")  # fmt: skip
+
+
+@pytest.mark.parametrize(("force", "torque"), [(3.0, 0.0), (0.0, 0.02), (3.0, 0.01), (1.0, 0.05)])
+def test_a_plate_on_a_disk_patch_has_the_closed_form_safety_factor_and_motion(force, torque):
+    push = Load(name="push", force=[force, 0, 0], point=[0, 0, 0], torque=[0, 0, torque])
+    problem = plate(push)
+    plan = Planner(problem).solve()
+    weight = 2.0 * 9.81
+    needed, u = least_normal_force(force, torque)
+    assert plan.status == "optimal"
+    assert plan.safety_factors["push"] == pytest.approx(weight / needed, rel=OPTIMUM_RTOL)
+    assert_loads_inside_their_exact_surfaces(problem, plan)
+    # The impending planar motion (dual of the equilibrium, (vx, vy, wz) of the twist):
+    # rotation about a point u R from the patch centre on the y axis (the push is along x),
+    # or a translation along x.
+    vx, vy, w = plan.motions["push"].twist[[0, 1, 5]]
+    if math.isinf(u):
+        assert abs(vy) < 1e-7 * abs(vx) and abs(w) * R < 1e-7 * abs(vx)
+    else:
+        assert abs(vy) < 1e-7 * abs(w) * R
+        assert abs(vx / w) == pytest.approx(u * R, rel=1e-6, abs=1e-9 * R)
+
+
+def test_point_supports_are_planned_on_their_facets_exactly():
+    # Three point supports: pushing about a support point slides the plate on that facet; the
+    # safety factor is the exact surface's (a facet of the point set, not a smoothed one).
+    points = pressure.points([[0.03, 0.0], [-0.02, 0.025], [-0.02, -0.03]], [1.0, 2.0, 1.5])
+    support = Contact(name="base", role="support", position=[0, 0, 0], normal=[0, 0, 1], mu=MU,
+                      model="exact", patch=points)  # fmt: skip
+    body = Body(mass=2.0, center_of_mass=[0, 0, 0.01])
+    surface = LimitSurface(points, mu=MU, normal_force=2.0 * 9.81)
+    xy = points.pose.apply(points.xy)[0]
+    facet = surface.load(np.array([xy[1], -xy[0], 1.0]))  # rotation about support point 0
+    push = Load(name="push", force=[facet[0], facet[1], 0], point=[0, 0, 0],
+                torque=[0, 0, facet[2]])  # fmt: skip
+    problem = Problem(body=body, contacts=[support], loads=[push], objective="max-safety-factor")
+    plan = Planner(problem).solve()
+    assert plan.status == "optimal"
+    assert plan.safety_factors["push"] == pytest.approx(1.0, rel=OPTIMUM_RTOL)
+    vx, vy, w = plan.motions["push"].twist[[0, 1, 5]]
+    np.testing.assert_allclose([-vy / w, vx / w], xy, rtol=1e-6)  # centre of rotation
+
+
+def test_re_solves_keep_every_contact_load_inside_its_exact_surface():
+    planner = Planner(pinch(Load(name="hold", force=[0, 0, -10.0], point=[0, 0, 0])))
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        weight, torque, offset = rng.uniform(1.0, 20.0), rng.uniform(0.0, 0.3), rng.normal(0, 0.02)
+        load = Load(name="hold", force=[0, 0, -weight], point=[offset, 0, 0], torque=[0, torque, 0])
+        plan = planner.solve([load])
+        assert plan.status == "optimal"
+        assert_loads_inside_their_exact_surfaces(planner.problem, plan)
+        # The weight at x = offset adds the moment weight * offset about the grasp axis y.
+        total = torque + weight * offset
+        expected, _ = least_normal_force(weight / 2.0, abs(total) / 2.0)
+        np.testing.assert_allclose(plan.normal_forces[:, 0], expected, rtol=OPTIMUM_RTOL)
