@@ -143,19 +143,18 @@ class Runner:
             assign(stacked.sense, float(sense))
         if stacked.unloaded is not None:
             assign(stacked.unloaded, 0.0 if unloaded is None else unloaded.astype(float))
-        direct = None if accurate else self._direct_result(objective, stacked)
+        cuts = stacked.cuts is not None  # rounds of cuts follow every solve
+        direct = None if accurate or cuts else self._direct_result(objective, stacked)
         if direct is not None:
             return direct
         notes = []
         solver = self.solver
-        status = _solve(stacked, solver, accurate, notes)
-        if status == "optimal":
-            self._prepare_direct(objective, stacked)
+        status = self._solve(objective, stacked, solver, accurate, notes)
         if status in ("solver-error", "inaccurate"):
             fallback = _FALLBACK[solver]
             notes.append(f"{solver} returned {status}; retried with {fallback}")
             solver = fallback
-            status = _solve(stacked, solver, False, notes)
+            status = self._solve(objective, stacked, solver, False, notes)
         result = {"status": status, "solver": solver, "warnings": notes}
         if status in ("optimal", "inaccurate"):
             result.update(_values(stacked))
@@ -164,17 +163,45 @@ class Runner:
             result["dual"] = None if dual is None else np.asarray(dual, dtype=float)
         return result
 
-    def _direct_result(self, objective: str, stacked: Stacked) -> dict | None:
-        """Solve straight through Clarabel when a direct solver exists for ``objective``."""
+    def _solve(self, objective, stacked: Stacked, solver: str, accurate: bool, notes) -> str:
+        """Solve ``stacked``, with rounds of cuts for its exact contacts (notes are appended);
+        each solve goes through Clarabel directly once a direct solver exists."""
+
+        def once() -> str:
+            if not accurate and solver == self.solver and self._direct_into(objective, stacked):
+                return "optimal"
+            status = _call(stacked.problem, solver, accurate=accurate)
+            if status == "optimal" and solver == self.solver:
+                self._prepare_direct(objective, stacked)
+            return status
+
+        status = once()
+        if stacked.cuts is None:
+            return status
+        status, more = stacked.cuts.converge(once, status)
+        notes.extend(more)
+        return status
+
+    def _direct_into(self, objective: str, stacked: Stacked) -> bool:
+        """Solve through Clarabel directly into the cvxpy variables and the equilibrium's
+        multipliers, where a direct solver exists and solves the problem."""
         direct = self._direct.get(objective)
         values = None if direct is None else direct.solve()
         dual = None if values is None else direct.dual(stacked.balance)
         if dual is None:
-            return None
+            return False
         for variable in stacked.problem.variables():
             variable.save_value(values[variable.id])
+        stacked.balance.save_dual_value(dual)
+        return True
+
+    def _direct_result(self, objective: str, stacked: Stacked) -> dict | None:
+        """Solve straight through Clarabel when a direct solver exists for ``objective``."""
+        if not self._direct_into(objective, stacked):
+            return None
+        dual = np.asarray(stacked.balance.dual_value, dtype=float)
         return {"status": "optimal", "solver": "CLARABEL (direct)", "warnings": [],
-                **_values(stacked), "dual": np.asarray(dual, dtype=float)}  # fmt: skip
+                **_values(stacked), "dual": dual}  # fmt: skip
 
     def _prepare_direct(self, objective: str, stacked: Stacked) -> None:
         """Build the direct solver of an objective after its second cvxpy solve.
@@ -183,8 +210,6 @@ class Runner:
         pay for it.
         """
         if self.solver != "CLARABEL":
-            return
-        if stacked.cuts is not None:  # the cuts move the conic data A
             return
         if objective in self._direct or stacked.problem.status != cp.OPTIMAL:
             return
@@ -209,18 +234,6 @@ def _uses_dpp(problem: cp.Problem) -> bool:
     """Whether ``problem`` is small enough for DPP to pay (see ``DPP_MAX_WORK``)."""
     entries = sum(parameter.size for parameter in problem.parameters())
     return problem.size_metrics.num_scalar_variables * max(entries, 1) <= DPP_MAX_WORK
-
-
-def _solve(stacked: Stacked, solver: str, accurate: bool, notes: list) -> str:
-    """Solve ``stacked``, with rounds of cuts for its exact contacts; notes are appended."""
-    status = _call(stacked.problem, solver, accurate=accurate)
-    if stacked.cuts is None:
-        return status
-    status, more = stacked.cuts.converge(
-        lambda: _call(stacked.problem, solver, accurate=accurate), status
-    )
-    notes.extend(more)
-    return status
 
 
 def _call(problem: cp.Problem, solver: str, *, accurate: bool = False) -> str:
