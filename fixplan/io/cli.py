@@ -678,7 +678,7 @@ def _surface_models(surface):
         "cone": Cone.from_limit_surface(surface),
         "pyramid (4, inscribed)": Pyramid.from_limit_surface(surface),
         "pyramid (8, inscribed)": Pyramid.from_limit_surface(surface, facets=8),
-        "exact (128 disks)": Exact.from_limit_surface(surface),
+        "exact": Exact.from_limit_surface(surface),
         "point-cone": PointCone.from_limit_surface(surface),
     }
 
