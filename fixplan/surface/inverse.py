@@ -22,6 +22,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from fixplan.errors import ConvergenceError
+from fixplan.surface.compiled_inverse import (
+    CRAWL,
+    FACETS_TESTED,
+    MAX_HALVINGS,
+    NEAR_KINK,
+    QUADRATIC_REGION,
+    RIDGE,
+    SMOOTHING_STAGES,
+    CompiledKernel,
+)
 from fixplan.surface.kernels import SupportKernel
 from fixplan.surface.point_kernel import slowest_points
 from fixplan.tolerances import (
@@ -30,26 +40,6 @@ from fixplan.tolerances import (
     INVERSE_MAX_ITERATIONS,
     INVERSE_RTOL,
 )
-
-#: Number of nearest support points whose facets are tested per query.
-_FACETS_TESTED = 3
-
-#: Newton decrement (relative to h) below which full steps are taken without a line search:
-#: there the iteration is quadratic and rounding would defeat the sufficient-decrease test.
-QUADRATIC_REGION = 1e-12
-
-#: A support point whose weighted speed is below this fraction of h sits on a possible kink.
-_NEAR_KINK = 1e-6
-
-#: Smoothing speeds (relative to the translation speed of the twist) of the continuation that
-#: takes over where Newton stalls at a kink.
-_SMOOTHING_STAGES = (1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
-
-#: A Newton step damped below this fraction signals a kink: Newton stops there.
-_CRAWL = 1e-3
-
-#: Most step halvings of the backtracking line search.
-_MAX_HALVINGS = 60
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,7 +70,7 @@ def _newton_step(g, hess, b1, b2):
     h11 = np.einsum("ij,ij->i", b1, hb1)
     h12 = np.einsum("ij,ij->i", b1, hb2)
     h22 = np.einsum("ij,ij->i", b2, hb2)
-    ridge = 1e-14 * np.abs(h11 + h22) + 1e-300
+    ridge = RIDGE * np.abs(h11 + h22) + 1e-300
     h11, h22 = h11 + ridge, h22 + ridge
     det = h11 * h22 - h12 * h12
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -107,7 +97,7 @@ def _newton(z, e1, e2, active, terms, values, *, kinks: bool = False) -> np.ndar
         # Near the minimum the sufficient decrease is below rounding: full steps are taken.
         accepted = done | (decrement <= QUADRATIC_REGION * h)
         t = np.ones(len(active))
-        for _ in range(_MAX_HALVINGS):
+        for _ in range(MAX_HALVINGS):
             idx = np.flatnonzero(~accepted)
             if idx.size == 0:
                 break
@@ -119,7 +109,7 @@ def _newton(z, e1, e2, active, terms, values, *, kinks: bool = False) -> np.ndar
         z[active[moved]] = za[moved] + t[moved, None] * step[moved]
         # With point supports, tiny accepted steps mean Newton is crawling into a kink: stop
         # and let the facet test and the smoothing continuation take over.
-        crawling = moved & (t < _CRAWL) if kinks else np.zeros_like(moved)
+        crawling = moved & (t < CRAWL) if kinks else np.zeros_like(moved)
         stalled[active[~accepted | crawling]] = True
         active = active[moved & ~crawling]
     stalled[active] = True
@@ -127,13 +117,24 @@ def _newton(z, e1, e2, active, terms, values, *, kinks: bool = False) -> np.ndar
 
 
 def solve(
-    kernel: SupportKernel, scale: float, loads: np.ndarray, units: np.ndarray
+    kernel: SupportKernel,
+    scale: float,
+    loads: np.ndarray,
+    units: np.ndarray,
+    compiled: CompiledKernel | None = None,
 ) -> InverseResult:
     """Safety factor and sliding twist of nonzero ``loads`` ``(K, 3)``.
 
     ``scale`` multiplies the kernel (``mu * N``), ``units`` = ``(max_force, max_force,
-    max_moment)`` normalise the coordinates.
+    max_moment)`` normalise the coordinates. ``compiled``, the kernel's compiled form where it
+    has one, runs the whole method in one compiled loop per load.
     """
+    if compiled is not None:
+        safety, twist, gradient = compiled.solve(loads, units, scale)
+        worst = int(np.argmax(gradient))
+        if gradient[worst] > INVERSE_GRADIENT_RTOL:
+            raise _not_converged(loads[worst], float(gradient[worst]))
+        return InverseResult(safety_factor=safety, twist=twist)
     points, friction = kernel.facets
     if len(loads) == 1 and len(points) == 0:
         safety, twist = _solve_one(kernel, loads[0], units)
@@ -153,7 +154,7 @@ def solve(
     if len(points):
         # Newton only stops short, or lands on a kink, next to a support point.
         _, slowest = slowest_points(points, friction, z / units, 1)
-        near_kink = slowest[:, 0] <= _NEAR_KINK * safety
+        near_kink = slowest[:, 0] <= NEAR_KINK * safety
         rows = np.flatnonzero(stalled | near_kink)
         on_facet = _facets(kernel, scale, loads, units, z, safety, points, friction, rows)
         retry = np.flatnonzero(stalled & ~on_facet)
@@ -195,7 +196,7 @@ def _solve_one(kernel: SupportKernel, load: np.ndarray, units: np.ndarray):
         # Near the minimum the sufficient decrease is below rounding: full steps are taken.
         if decrement > QUADRATIC_REGION * h and terms[0] > h - 1e-4 * decrement:
             t = 0.5
-            for _ in range(_MAX_HALVINGS - 1):
+            for _ in range(MAX_HALVINGS - 1):
                 trial = [x + t * dx for x, dx in zip(twist, step, strict=True)]
                 if float(kernel.support(np.array([trial]))[0]) <= h - 1e-4 * t * decrement:
                     break
@@ -245,7 +246,7 @@ def _plane_basis_one(direction: list[float]) -> tuple[list[float], list[float]]:
 def _newton_step_one(g1, g2, h11, h12, h22) -> tuple[tuple[float, float], float]:
     """:func:`_newton_step` of one point from its projected gradient and Hessian: the step in
     plane coordinates and the decrement."""
-    ridge = 1e-14 * abs(h11 + h22) + 1e-300
+    ridge = RIDGE * abs(h11 + h22) + 1e-300
     h11, h22 = h11 + ridge, h22 + ridge
     det = h11 * h22 - h12 * h12
     if det > 0.0:
@@ -289,7 +290,7 @@ def _facets(kernel, scale, loads, units, z, safety, points, friction, rows) -> n
     on_facet = np.zeros(len(loads), dtype=bool)
     if rows.size == 0:
         return on_facet
-    nearest, _ = slowest_points(points, friction, z[rows] / units, _FACETS_TESTED)
+    nearest, _ = slowest_points(points, friction, z[rows] / units, FACETS_TESTED)
     for column in range(nearest.shape[1]):
         k = nearest[:, column]
         px, py = points[k, 0], points[k, 1]
@@ -339,7 +340,7 @@ def _continuation(kernel, scale, units, z, safety, e1, e2, rows) -> None:
     the lower ``h`` is the better answer). ``z`` and ``safety`` are updated in place.
     """
     start = z[rows].copy()
-    for eta in _SMOOTHING_STAGES:
+    for eta in SMOOTHING_STAGES:
         terms, values = _objective(kernel.smoothed(eta / units[0]), scale, units)
         _newton(z, e1, e2, rows, terms, values)
     terms, values = _objective(kernel, scale, units)

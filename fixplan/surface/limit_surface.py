@@ -36,6 +36,7 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError
+from fixplan.surface.compiled_inverse import compile_kernel
 from fixplan.surface.disk_kernel import AnnulusKernel, DiskKernel
 from fixplan.surface.geometry import Pose, triangulate
 from fixplan.surface.inverse import solve
@@ -86,7 +87,17 @@ class LimitSurface:
         Total normal force [N], > 0.
     """
 
-    __slots__ = ("_kernel", "_mu", "_normal_force", "_parts", "_scale", "_shape", "_units", "field")
+    __slots__ = (
+        "_compiled",
+        "_kernel",
+        "_mu",
+        "_normal_force",
+        "_parts",
+        "_scale",
+        "_shape",
+        "_units",
+        "field",
+    )
 
     def __init__(self, field: PressureField, *, mu: float | Callable, normal_force: float = 1.0):
         if not isinstance(field, PressureField):
@@ -115,6 +126,7 @@ class LimitSurface:
         self, kernel: SupportKernel, scale: float, shape: LimitSurface | None = None
     ) -> None:
         self._kernel = kernel
+        self._compiled = compile_kernel(kernel)
         self._scale = scale
         self._shape = shape
         probe = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
@@ -235,7 +247,7 @@ class LimitSurface:
         if single and zero is None:
             # Solve for a load of unit size (normalised): s(c L) = s(L) / c.
             size = float(np.max(np.abs(loads[0] / self._units)))
-            result = solve(self._kernel, self._scale, loads / size, self._units)
+            result = solve(self._kernel, self._scale, loads / size, self._units, self._compiled)
             return result.safety_factor / size, result.twist, True
         safety = np.full(len(loads), np.inf)
         twists = np.full((len(loads), 3), np.nan)
@@ -245,7 +257,9 @@ class LimitSurface:
         for start in range(0, len(nonzero), _CHUNK):
             rows = nonzero[start : start + _CHUNK]
             scale = size[start : start + _CHUNK, None]
-            result = solve(self._kernel, self._scale, loads[rows] / scale, self._units)
+            result = solve(
+                self._kernel, self._scale, loads[rows] / scale, self._units, self._compiled
+            )
             safety[rows] = result.safety_factor / scale[:, 0]
             twists[rows] = result.twist
         return safety, twists, single
