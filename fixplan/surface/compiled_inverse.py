@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from fixplan.errors import ConvergenceError
 from fixplan.surface.kernels import PosedKernel, SupportKernel, twist_to_local
 from fixplan.surface.point_kernel import (
     _POINT_TERMS,
@@ -29,7 +30,13 @@ from fixplan.surface.point_kernel import (
     compiled_scalar,
 )
 from fixplan.surface.polygon_kernel import _EDGE_TERMS, EdgeSumKernel
-from fixplan.tolerances import FACET_RTOL, FAR_FIELD_RADII, INVERSE_MAX_ITERATIONS, INVERSE_RTOL
+from fixplan.tolerances import (
+    FACET_RTOL,
+    FAR_FIELD_RADII,
+    INVERSE_GRADIENT_RTOL,
+    INVERSE_MAX_ITERATIONS,
+    INVERSE_RTOL,
+)
 
 #: Kinds of compiled kernels: weighted points, or polygon edges with a far-field point rule.
 POINTS = 0
@@ -316,9 +323,19 @@ def _solve(
     kernel, discrete, loads, units, scale, out_safety, out_twist, out_gradient
 ):  # pragma: no cover
     for k in numba.prange(loads.shape[0]):
-        out_safety[k], out_gradient[k] = _solve_load(
-            kernel, discrete, loads[k], units, scale, out_twist[k]
+        # Solve for a load of unit size (normalised): s(c L) = s(L) / c.
+        size = 0.0
+        for i in range(3):
+            size = max(size, abs(loads[k, i] / units[i]))
+        if size == 0.0:
+            out_safety[k] = np.inf
+            out_twist[k, :] = np.nan
+            out_gradient[k] = 0.0
+            continue
+        safety, out_gradient[k] = _solve_load(
+            kernel, discrete, loads[k] / size, units, scale, out_twist[k]
         )
+        out_safety[k] = safety / size
 
 
 _terms = compiled_scalar(_terms)
@@ -349,26 +366,36 @@ class CompiledKernel:
 
     def solve(
         self, loads: np.ndarray, units: np.ndarray, scale: float
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Safety factors ``(K,)``, sliding twists ``(K, 3)`` [SI] and relative projected
-        gradients ``(K,)`` (0 where Newton converged or the load lies on a facet) of nonzero
-        ``loads`` ``(K, 3)`` [N, N m]; ``units`` = ``(max_force, max_force, max_moment)``
-        normalise the coordinates and ``scale`` (``mu * N``) multiplies the kernel."""
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Safety factors ``(K,)`` and sliding twists ``(K, 3)`` [SI] of ``loads`` ``(K, 3)``
+        [N, N m] (``inf`` and NaN for a zero load); ``units`` = ``(max_force, max_force,
+        max_moment)`` normalise the coordinates and ``scale`` (``mu * N``) multiplies the kernel.
+
+        Raises :class:`ConvergenceError` where Newton stopped away from a minimum.
+        """
         count = len(loads)
         safety = np.empty(count)
         twist = np.empty((count, 3))
         gradient = np.empty(count)
+        loads = np.ascontiguousarray(loads, dtype=float)
         _pick(_SOLVE, count, self.work)(
-            self.parts,
-            self.discrete,
-            np.ascontiguousarray(loads, dtype=float),
-            np.ascontiguousarray(units, dtype=float),
-            float(scale),
-            safety,
-            twist,
-            gradient,
+            self.parts, self.discrete, loads, units, scale, safety, twist, gradient
         )
-        return safety, twist, gradient
+        worst = int(np.argmax(gradient)) if count > 1 else 0
+        if gradient[worst] > INVERSE_GRADIENT_RTOL:
+            raise not_converged(loads[worst], float(gradient[worst]))
+        return safety, twist
+
+
+def not_converged(load: np.ndarray, relative_gradient: float) -> ConvergenceError:
+    """The error of a load where Newton stopped away from a minimum."""
+    return ConvergenceError(
+        f"the inverse map did not converge for load {load.tolist()} (relative gradient "
+        f"{relative_gradient:.2g}). Pressure and friction functions must be smooth over the "
+        "patch: where mu or p jumps or has a kink (two materials, a step in pressure), describe "
+        "each smooth region as its own patch and sum them with LimitSurface.combine. Otherwise, "
+        "please report this load."
+    )
 
 
 def compile_kernel(kernel: SupportKernel) -> CompiledKernel | None:

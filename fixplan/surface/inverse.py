@@ -21,7 +21,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fixplan.errors import ConvergenceError
 from fixplan.surface.compiled_inverse import (
     CRAWL,
     FACETS_TESTED,
@@ -30,7 +29,7 @@ from fixplan.surface.compiled_inverse import (
     QUADRATIC_REGION,
     RIDGE,
     SMOOTHING_STAGES,
-    CompiledKernel,
+    not_converged,
 )
 from fixplan.surface.kernels import SupportKernel
 from fixplan.surface.point_kernel import slowest_points
@@ -117,24 +116,14 @@ def _newton(z, e1, e2, active, terms, values, *, kinks: bool = False) -> np.ndar
 
 
 def solve(
-    kernel: SupportKernel,
-    scale: float,
-    loads: np.ndarray,
-    units: np.ndarray,
-    compiled: CompiledKernel | None = None,
+    kernel: SupportKernel, scale: float, loads: np.ndarray, units: np.ndarray
 ) -> InverseResult:
     """Safety factor and sliding twist of nonzero ``loads`` ``(K, 3)``.
 
     ``scale`` multiplies the kernel (``mu * N``), ``units`` = ``(max_force, max_force,
-    max_moment)`` normalise the coordinates. ``compiled``, the kernel's compiled form where it
-    has one, runs the whole method in one compiled loop per load.
+    max_moment)`` normalise the coordinates. Kernels with a compiled form take
+    :class:`~fixplan.surface.compiled_inverse.CompiledKernel` instead.
     """
-    if compiled is not None:
-        safety, twist, gradient = compiled.solve(loads, units, scale)
-        worst = int(np.argmax(gradient))
-        if gradient[worst] > INVERSE_GRADIENT_RTOL:
-            raise _not_converged(loads[worst], float(gradient[worst]))
-        return InverseResult(safety_factor=safety, twist=twist)
     points, friction = kernel.facets
     if len(loads) == 1 and len(points) == 0:
         safety, twist = _solve_one(kernel, loads[0], units)
@@ -209,7 +198,7 @@ def _solve_one(kernel: SupportKernel, load: np.ndarray, units: np.ndarray):
     if stalled:
         g1, g2 = _projected(g, hess, b1, b2)[:2]
         if math.hypot(g1, g2) > INVERSE_GRADIENT_RTOL * h:
-            raise _not_converged(load, math.hypot(g1, g2) / h)
+            raise not_converged(load, math.hypot(g1, g2) / h)
     return h, np.array(twist)
 
 
@@ -267,18 +256,7 @@ def _check_converged(z, e1, e2, loads, terms) -> None:
     projected = np.hypot(np.einsum("ij,ij->i", g, e1), np.einsum("ij,ij->i", g, e2))
     bad = np.flatnonzero(projected > INVERSE_GRADIENT_RTOL * h)
     if bad.size:
-        raise _not_converged(loads[bad[0]], projected[bad[0]] / h[bad[0]])
-
-
-def _not_converged(load: np.ndarray, relative_gradient: float) -> ConvergenceError:
-    """The error of a load where Newton stopped away from a minimum."""
-    return ConvergenceError(
-        f"the inverse map did not converge for load {load.tolist()} (relative gradient "
-        f"{relative_gradient:.2g}). Pressure and friction functions must be smooth over the "
-        "patch: where mu or p jumps or has a kink (two materials, a step in pressure), describe "
-        "each smooth region as its own patch and sum them with LimitSurface.combine. Otherwise, "
-        "please report this load."
-    )
+        raise not_converged(loads[bad[0]], projected[bad[0]] / h[bad[0]])
 
 
 def _facets(kernel, scale, loads, units, z, safety, points, friction, rows) -> np.ndarray:

@@ -244,10 +244,12 @@ class LimitSurface:
             # Frictionless: only the load 0 is held; the motion is the limit mu -> 0+.
             safety = np.where(np.any(loads != 0.0, axis=1), 0.0, np.inf)
             return safety, self._shape._inverse(loads)[1], single
+        if self._compiled is not None:
+            return (*self._compiled.solve(loads, self._units, self._scale), single)
         if single and zero is None:
             # Solve for a load of unit size (normalised): s(c L) = s(L) / c.
             size = float(np.max(np.abs(loads[0] / self._units)))
-            result = solve(self._kernel, self._scale, loads / size, self._units, self._compiled)
+            result = solve(self._kernel, self._scale, loads / size, self._units)
             return result.safety_factor / size, result.twist, True
         safety = np.full(len(loads), np.inf)
         twists = np.full((len(loads), 3), np.nan)
@@ -257,9 +259,7 @@ class LimitSurface:
         for start in range(0, len(nonzero), _CHUNK):
             rows = nonzero[start : start + _CHUNK]
             scale = size[start : start + _CHUNK, None]
-            result = solve(
-                self._kernel, self._scale, loads[rows] / scale, self._units, self._compiled
-            )
+            result = solve(self._kernel, self._scale, loads[rows] / scale, self._units)
             safety[rows] = result.safety_factor / scale[:, 0]
             twists[rows] = result.twist
         return safety, twists, single
@@ -298,7 +298,11 @@ class LimitSurface:
         return self._unit_twists(twists), safety
 
     def _unit_twists(self, twists: np.ndarray) -> np.ndarray:
-        scaled = twists * np.array([1.0, 1.0, self.characteristic_length])
+        rho = self.characteristic_length
+        if twists.ndim == 1:  # one query: floats cost less than NumPy calls
+            vx, vy, w = twists.tolist()
+            return twists / math.sqrt(vx * vx + vy * vy + (rho * w) ** 2)
+        scaled = twists * np.array([1.0, 1.0, rho])
         return twists / np.linalg.norm(scaled, axis=-1, keepdims=True)
 
     # -- plotting and fitting -----------------------------------------------------------------

@@ -24,16 +24,43 @@ from fixplan.surface.kernels import SupportKernel
 #: (one point of the facet) instead of a unit force in the direction of rounding noise.
 STATIONARY_RTOL = 1e-12
 
-_JIT = {"fastmath": {"reassoc", "contract"}, "nogil": True}
+_JIT = {"fastmath": {"reassoc", "contract"}, "nogil": True, "error_model": "numpy"}
 
 
 def point_terms(px, py, pw, eps2, vx, vy, w, with_hessian, out):  # pragma: no cover - compiled
     """Support value, gradient and (``with_hessian``) Hessian at one twist ``(vx, vy, w)``,
-    written to ``out`` ``(10,)``: ``h``, ``g`` (3), then ``H`` 00, 01, 02, 11, 12, 22."""
+    written to ``out`` ``(10,)``: ``h``, ``g`` (3), then ``H`` 00, 01, 02, 11, 12, 22.
+
+    With ``s = sqrt(|u|² + eps²)``, ``A = [[1, 0, -y], [0, 1, x]]`` and ``e = u / s``:
+    ``ds/dV = Aᵀ e``, ``d²s/dV² = Aᵀ (I - e eᵀ) A / s``. The loops are free of branches (a
+    stationary point is masked out by a zero weight) so that they vectorise.
+    """
+    base = abs(vx) + abs(vy)
+    spin = abs(w)
     h = 0.0
     g0 = 0.0
     g1 = 0.0
     g2 = 0.0
+    if not with_hessian:
+        for i in range(px.shape[0]):
+            x = px[i]
+            y = py[i]
+            ux = vx - w * y
+            uy = vy + w * x
+            speed = math.sqrt(ux * ux + uy * uy + eps2)
+            moving = speed > STATIONARY_RTOL * (base + spin * (abs(x) + abs(y)))
+            c = pw[i] / speed if moving else 0.0
+            gx = c * ux
+            gy = c * uy
+            h += c * speed * speed
+            g0 += gx
+            g1 += gy
+            g2 += x * gy - y * gx
+        out[0] = h
+        out[1] = g0
+        out[2] = g1
+        out[3] = g2
+        return
     h00 = 0.0
     h01 = 0.0
     h02 = 0.0
@@ -46,26 +73,26 @@ def point_terms(px, py, pw, eps2, vx, vy, w, with_hessian, out):  # pragma: no c
         ux = vx - w * y
         uy = vy + w * x
         speed = math.sqrt(ux * ux + uy * uy + eps2)
-        if speed > STATIONARY_RTOL * (abs(vx) + abs(vy) + abs(w) * (abs(x) + abs(y))):
-            # With s = sqrt(|u|² + eps²), A = [[1, 0, -y], [0, 1, x]] and e = u / s:
-            # ds/dV = A^T e, d²s/dV² = A^T (I - e e^T) A / s.
-            ex = ux / speed
-            ey = uy / speed
-            h += pw[i] * speed
-            g0 += pw[i] * ex
-            g1 += pw[i] * ey
-            g2 += pw[i] * (x * ey - y * ex)
-            if with_hessian:
-                c = pw[i] / speed
-                m00 = c * (1.0 - ex * ex)
-                m01 = -c * ex * ey
-                m11 = c * (1.0 - ey * ey)
-                h00 += m00
-                h01 += m01
-                h11 += m11
-                h02 += -y * m00 + x * m01
-                h12 += -y * m01 + x * m11
-                h22 += y * y * m00 - 2.0 * x * y * m01 + x * x * m11
+        moving = speed > STATIONARY_RTOL * (base + spin * (abs(x) + abs(y)))
+        inverse = 1.0 / speed if moving else 0.0
+        c = pw[i] * inverse
+        ex = ux * inverse
+        ey = uy * inverse
+        h += c * speed * speed
+        gx = pw[i] * ex
+        gy = pw[i] * ey
+        g0 += gx
+        g1 += gy
+        g2 += x * gy - y * gx
+        m00 = c - c * ex * ex
+        m01 = -c * ex * ey
+        m11 = c - c * ey * ey
+        h00 += m00
+        h01 += m01
+        h11 += m11
+        h02 += x * m01 - y * m00
+        h12 += x * m11 - y * m01
+        h22 += y * y * m00 - 2.0 * x * y * m01 + x * x * m11
     out[0] = h
     out[1] = g0
     out[2] = g1
