@@ -53,6 +53,12 @@ QUADRATIC_REGION = 1e-12
 #: possible kink.
 NEAR_KINK = 1e-6
 
+#: Kink handling of :func:`_newton`: none (smooth functions), stop where steps crawl into a
+#: kink, or also stop at the first rejected full step and name the kink it crosses.
+SMOOTH = 0
+CRAWLS = 1
+PROBES = 2
+
 #: Smoothing speeds (relative to the translation speed of the twist) of the continuation that
 #: takes over where Newton stalls at a kink.
 SMOOTHING_STAGES = (1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
@@ -152,8 +158,10 @@ def _newton_step(g1, g2, h11, h12, h22):  # pragma: no cover - compiled
 
 def _newton(kernel, eps2, twist, b1, b2, kinks):  # pragma: no cover - compiled
     """Damped Newton on the plane through ``twist`` spanned by ``b1``, ``b2`` [SI], in place on
-    ``twist``; True where it stalled (no descent, a crawl into a kink with ``kinks``, or the
-    iteration limit)."""
+    ``twist``. Returns whether it stalled (no descent, a crawl into a kink unless ``kinks`` is
+    :data:`SMOOTH`, or the iteration limit), the support value at the final ``twist`` and,
+    with ``kinks`` :data:`PROBES`, the support point whose kink the first rejected full step
+    crosses (Newton stops there; else -1)."""
     local = np.empty(10)
     current = np.empty(10)
     new = np.empty(10)
@@ -164,7 +172,7 @@ def _newton(kernel, eps2, twist, b1, b2, kinks):  # pragma: no cover - compiled
         h = current[0]
         s1, s2, decrement = _newton_step(*_projected(current, b1, b2))
         if decrement <= INVERSE_RTOL**2 * h:
-            return False
+            return False, h, -1
         for i in range(3):
             step[i] = s1 * b1[i] + s2 * b2[i]
             trial[i] = twist[i] + step[i]
@@ -173,6 +181,8 @@ def _newton(kernel, eps2, twist, b1, b2, kinks):  # pragma: no cover - compiled
         t = 1.0
         # Near the minimum the sufficient decrease is below rounding: full steps are taken.
         if decrement > QUADRATIC_REGION * h and new[0] > h - _ARMIJO * decrement:
+            if kinks == PROBES:
+                return True, h, _nearest_kink(kernel, twist, step)
             accepted = False
             for _ in range(MAX_HALVINGS - 1):
                 t *= 0.5
@@ -183,21 +193,13 @@ def _newton(kernel, eps2, twist, b1, b2, kinks):  # pragma: no cover - compiled
                     accepted = True
                     break
             if not accepted:
-                return True
+                return True, h, -1
             _terms(kernel, eps2, trial, True, local, new)
         twist[:] = trial
         current[:] = new
-        if kinks and t < CRAWL:
-            return True
-    return True
-
-
-def _support(kernel, twist):  # pragma: no cover - compiled
-    """Unit-friction support value at ``twist``."""
-    local = np.empty(10)
-    out = np.empty(10)
-    _terms(kernel, 0.0, twist, False, local, out)
-    return out[0]
+        if kinks != SMOOTH and t < CRAWL:
+            return True, current[0], -1
+    return True, current[0], -1
 
 
 def _slowest(kernel, twist, index, speed):  # pragma: no cover - compiled
@@ -221,35 +223,130 @@ def _slowest(kernel, twist, index, speed):  # pragma: no cover - compiled
             index[j] = i
 
 
+def _facet(kernel, load, scale, k, twist):  # pragma: no cover - compiled
+    """The safety factor of ``load`` on the facet of support point ``k`` (the twist of that
+    facet in ``twist``), or ``inf`` where the load does not lie on it: where the force point
+    ``k`` must carry to balance it is above its friction limit."""
+    _, px, py, pw, _, _, _, _ = kernel
+    twist[0], twist[1], twist[2] = py[k], -px[k], 1.0
+    power = load[0] * twist[0] + load[1] * twist[1] + load[2]
+    if power < 0.0:
+        twist[:] = -twist
+        power = -power
+    if not power > 0.0:
+        return np.inf
+    twist /= power
+    local = np.empty(10)
+    out = np.empty(10)
+    _terms(kernel, 0.0, twist, False, local, out)
+    s_k = scale * out[0]
+    carried = math.hypot(s_k * load[0] - scale * out[1], s_k * load[1] - scale * out[2])
+    return s_k if carried <= scale * pw[k] * (1.0 + FACET_RTOL) else np.inf
+
+
 def _facets(kernel, load, scale, twist, safety):  # pragma: no cover - compiled
     """The safety factor on the facets of the slowest support points where ``load`` lies on
     one (``twist`` is then set to the facet's twist), else ``safety``; and whether it does."""
-    _, px, py, pw, _, _, _, _ = kernel
-    count = min(FACETS_TESTED, px.shape[0])
+    count = min(FACETS_TESTED, kernel[1].shape[0])
     index = np.empty(count, dtype=np.int64)
     speed = np.empty(count)
     _slowest(kernel, twist, index, speed)
-    local = np.empty(10)
-    out = np.empty(10)
     facet = np.empty(3)
     on_facet = False
     for k in index:
-        facet[0], facet[1], facet[2] = py[k], -px[k], 1.0
-        power = load[0] * facet[0] + load[1] * facet[1] + load[2]
-        if power < 0.0:
-            facet[:] = -facet
-            power = -power
-        if not power > 0.0:
-            continue
-        _terms(kernel, 0.0, facet, False, local, out)
-        s_k = scale * out[0] / power
-        carried = math.hypot(s_k * load[0] - scale * out[1], s_k * load[1] - scale * out[2])
-        if carried <= scale * pw[k] * (1.0 + FACET_RTOL) and s_k <= safety * (1.0 + 1e-9):
+        s_k = _facet(kernel, load, scale, k, facet)
+        if s_k <= safety * (1.0 + 1e-9):
             safety = s_k
-            for i in range(3):
-                twist[i] = facet[i] / power
+            twist[:] = facet
             on_facet = True
     return safety, on_facet
+
+
+def _nearest_kink(kernel, twist, step):  # pragma: no cover - compiled
+    """The support point that comes nearest to standing still (least weighted speed) on the
+    segment from ``twist`` to ``twist + step``: the kink a rejected Newton step crosses."""
+    _, px, py, pw, _, _, _, _ = kernel
+    best = np.inf
+    nearest = 0
+    for i in range(px.shape[0]):
+        ux = twist[0] - twist[2] * py[i]
+        uy = twist[1] + twist[2] * px[i]
+        dx = step[0] - step[2] * py[i]
+        dy = step[1] + step[2] * px[i]
+        t = min(max(-(ux * dx + uy * dy) / (dx * dx + dy * dy), 0.0), 1.0)
+        ex = ux + t * dx
+        ey = uy + t * dy
+        speed = (ex * ex + ey * ey) * pw[i] * pw[i]
+        if speed < best:
+            best = speed
+            nearest = i
+    return nearest
+
+
+def _certify_kink(kernel, load, scale, twist, b1, b2, k):  # pragma: no cover - compiled
+    """The safety factor where ``load`` lies on the facet of support point ``k`` or where Newton
+    converges next to its kink (:func:`_escape_kink`), with ``twist`` set to the motion; 0
+    (``twist`` unchanged) otherwise. Either is a certificate: ``h`` is convex on the plane."""
+    facet = np.empty(3)
+    s_k = _facet(kernel, load, scale, k, facet)
+    if s_k < np.inf:
+        twist[:] = facet
+        return s_k
+    return scale * _escape_kink(kernel, load, twist, b1, b2, k)
+
+
+def _escape_kink(kernel, load, twist, b1, b2, k):  # pragma: no cover - compiled
+    r"""Newton's minimum next to the kink of support point ``k`` where it stalled there and the
+    load is not on that point's facet; ``twist`` is set to it. Returns its support value, or
+    0 (``twist`` unchanged) where Newton does not converge from the start below.
+
+    On the plane, the speed of point ``k`` is ``u = M (α, β)`` (``M`` = ``[A b1, A b2]``,
+    ``A = [[1, 0, -y_k], [0, 1, x_k]]``), zero at the facet's twist ``F``. With the gradient
+    ``G`` and Hessian ``H`` of the other points at ``F`` (``g_u = M⁻ᵀ (G·b1, G·b2)``, larger
+    than the weight ``w_k`` off the facet) the support along ``u = -r ĝ_u`` is
+    ``h(F) - r |g_u| + w_k r + r² dᵀHd / 2``, least at ``r = (|g_u| - w_k) / dᵀHd``: a start
+    on the smooth side of the kink, from which Newton converges quadratically.
+    """
+    _, px, py, pw, _, _, _, _ = kernel
+    facet = np.empty(3)
+    facet[0], facet[1], facet[2] = py[k], -px[k], 1.0
+    power = load[0] * facet[0] + load[1] * facet[1] + load[2]
+    if power == 0.0:
+        return 0.0
+    facet /= power
+    local = np.empty(10)
+    rest = np.empty(10)
+    _terms(kernel, 0.0, facet, True, local, rest)
+    m00 = b1[0] - b1[2] * py[k]
+    m10 = b1[1] + b1[2] * px[k]
+    m01 = b2[0] - b2[2] * py[k]
+    m11 = b2[1] + b2[2] * px[k]
+    det = m00 * m11 - m01 * m10
+    g1 = rest[1] * b1[0] + rest[2] * b1[1] + rest[3] * b1[2]
+    g2 = rest[1] * b2[0] + rest[2] * b2[1] + rest[3] * b2[2]
+    gu0 = (m11 * g1 - m10 * g2) / det
+    gu1 = (-m01 * g1 + m00 * g2) / det
+    pull = math.hypot(gu0, gu1)
+    if not pull > pw[k]:
+        return 0.0
+    # Plane direction δ = M⁻¹ û with û = -g_u / |g_u|.
+    d0 = -(m11 * gu0 - m01 * gu1) / (det * pull)
+    d1 = -(-m10 * gu0 + m00 * gu1) / (det * pull)
+    d = d0 * b1 + d1 * b2
+    hess = np.empty((3, 3))
+    _unpack(rest, hess)
+    curvature = 0.0
+    for i in range(3):
+        for j in range(3):
+            curvature += d[i] * hess[i, j] * d[j]
+    if not (curvature > 0.0 and math.isfinite(curvature)):
+        return 0.0
+    start = facet + ((pull - pw[k]) / curvature) * d
+    stalled, h, _ = _newton(kernel, 0.0, start, b1, b2, CRAWLS)
+    if stalled:
+        return 0.0
+    twist[:] = start
+    return h
 
 
 def _continuation(kernel, units, scale, twist, safety, b1, b2):  # pragma: no cover - compiled
@@ -259,9 +356,8 @@ def _continuation(kernel, units, scale, twist, safety, b1, b2):  # pragma: no co
     the safety factor."""
     start = twist.copy()
     for eta in SMOOTHING_STAGES:
-        _newton(kernel, (eta / units[0]) ** 2, twist, b1, b2, False)
-    _newton(kernel, 0.0, twist, b1, b2, False)
-    found = scale * _support(kernel, twist)
+        _newton(kernel, (eta / units[0]) ** 2, twist, b1, b2, SMOOTH)
+    found = scale * _newton(kernel, 0.0, twist, b1, b2, SMOOTH)[1]
     if found < safety:
         return found
     twist[:] = start
@@ -297,8 +393,13 @@ def _solve_load(kernel, discrete, load, units, scale, twist):  # pragma: no cove
     b1 = np.empty(3)
     b2 = np.empty(3)
     _plane(load, units, twist, b1, b2)
-    stalled = _newton(kernel, 0.0, twist, b1, b2, discrete)
-    safety = scale * _support(kernel, twist)
+    stalled, h, kink = _newton(kernel, 0.0, twist, b1, b2, PROBES if discrete else SMOOTH)
+    if kink >= 0:
+        certified = _certify_kink(kernel, load, scale, twist, b1, b2, kink)
+        if certified > 0.0:
+            return certified, 0.0
+        stalled, h, _ = _newton(kernel, 0.0, twist, b1, b2, CRAWLS)
+    safety = scale * h
     on_facet = False
     if discrete:
         index = np.empty(1, dtype=np.int64)
@@ -307,6 +408,9 @@ def _solve_load(kernel, discrete, load, units, scale, twist):  # pragma: no cove
         if stalled or speed[0] <= NEAR_KINK * safety:
             safety, on_facet = _facets(kernel, load, scale, twist, safety)
         if stalled and not on_facet:
+            escaped = scale * _escape_kink(kernel, load, twist, b1, b2, index[0])
+            if escaped > 0.0 and escaped <= safety:
+                return escaped, 0.0
             safety = _continuation(kernel, units, scale, twist, safety, b1, b2)
             safety, on_facet = _facets(kernel, load, scale, twist, safety)
     if not stalled or on_facet:
@@ -343,9 +447,12 @@ _unpack = compiled_scalar(_unpack)
 _projected = compiled_scalar(_projected)
 _newton_step = compiled_scalar(_newton_step)
 _newton = compiled_scalar(_newton)
-_support = compiled_scalar(_support)
 _slowest = compiled_scalar(_slowest)
 _facets = compiled_scalar(_facets)
+_facet = compiled_scalar(_facet)
+_nearest_kink = compiled_scalar(_nearest_kink)
+_escape_kink = compiled_scalar(_escape_kink)
+_certify_kink = compiled_scalar(_certify_kink)
 _continuation = compiled_scalar(_continuation)
 _plane = compiled_scalar(_plane)
 _solve_load = compiled_scalar(_solve_load)
