@@ -223,24 +223,21 @@ def _slowest(kernel, twist, index, speed):  # pragma: no cover - compiled
             index[j] = i
 
 
-def _facet(kernel, load, scale, k, twist):  # pragma: no cover - compiled
-    """The safety factor of ``load`` on the facet of support point ``k`` (the twist of that
-    facet in ``twist``), or ``inf`` where the load does not lie on it: where the force point
-    ``k`` must carry to balance it is above its friction limit."""
+def _facet(kernel, load, scale, k, twist, with_hessian, terms):  # pragma: no cover - compiled
+    """The safety factor of ``load`` on the facet of support point ``k``; ``inf`` where the load
+    does not lie on it (the force point ``k`` must carry to balance it is above its friction
+    limit), NaN where the facet is parallel to the load. The facet's twist (on the plane
+    ``L·V = 1``) is left in ``twist`` and the terms of the other points there in ``terms``."""
     _, px, py, pw, _, _, _, _ = kernel
     twist[0], twist[1], twist[2] = py[k], -px[k], 1.0
     power = load[0] * twist[0] + load[1] * twist[1] + load[2]
-    if power < 0.0:
-        twist[:] = -twist
-        power = -power
-    if not power > 0.0:
-        return np.inf
+    if power == 0.0:
+        return np.nan
     twist /= power
     local = np.empty(10)
-    out = np.empty(10)
-    _terms(kernel, 0.0, twist, False, local, out)
-    s_k = scale * out[0]
-    carried = math.hypot(s_k * load[0] - scale * out[1], s_k * load[1] - scale * out[2])
+    _terms(kernel, 0.0, twist, with_hessian, local, terms)
+    s_k = scale * terms[0]
+    carried = math.hypot(s_k * load[0] - scale * terms[1], s_k * load[1] - scale * terms[2])
     return s_k if carried <= scale * pw[k] * (1.0 + FACET_RTOL) else np.inf
 
 
@@ -252,9 +249,10 @@ def _facets(kernel, load, scale, twist, safety):  # pragma: no cover - compiled
     speed = np.empty(count)
     _slowest(kernel, twist, index, speed)
     facet = np.empty(3)
+    terms = np.empty(10)
     on_facet = False
     for k in index:
-        s_k = _facet(kernel, load, scale, k, facet)
+        s_k = _facet(kernel, load, scale, k, facet, False, terms)
         if s_k <= safety * (1.0 + 1e-9):
             safety = s_k
             twist[:] = facet
@@ -288,17 +286,21 @@ def _certify_kink(kernel, load, scale, twist, b1, b2, k):  # pragma: no cover - 
     converges next to its kink (:func:`_escape_kink`), with ``twist`` set to the motion; 0
     (``twist`` unchanged) otherwise. Either is a certificate: ``h`` is convex on the plane."""
     facet = np.empty(3)
-    s_k = _facet(kernel, load, scale, k, facet)
+    rest = np.empty(10)
+    s_k = _facet(kernel, load, scale, k, facet, True, rest)
     if s_k < np.inf:
         twist[:] = facet
         return s_k
-    return scale * _escape_kink(kernel, load, twist, b1, b2, k)
+    if math.isnan(s_k):
+        return 0.0
+    return scale * _escape_kink(kernel, twist, b1, b2, k, facet, rest)
 
 
-def _escape_kink(kernel, load, twist, b1, b2, k):  # pragma: no cover - compiled
-    r"""Newton's minimum next to the kink of support point ``k`` where it stalled there and the
-    load is not on that point's facet; ``twist`` is set to it. Returns its support value, or
-    0 (``twist`` unchanged) where Newton does not converge from the start below.
+def _escape_kink(kernel, twist, b1, b2, k, facet, rest):  # pragma: no cover - compiled
+    r"""Newton's minimum next to the kink of support point ``k`` where the load is not on that
+    point's facet (twist ``facet``, where the other points have the terms ``rest``); ``twist``
+    is set to it. Returns its support value, or 0 (``twist`` unchanged) where Newton does not
+    converge from the start below.
 
     On the plane, the speed of point ``k`` is ``u = M (α, β)`` (``M`` = ``[A b1, A b2]``,
     ``A = [[1, 0, -y_k], [0, 1, x_k]]``), zero at the facet's twist ``F``. With the gradient
@@ -308,15 +310,6 @@ def _escape_kink(kernel, load, twist, b1, b2, k):  # pragma: no cover - compiled
     on the smooth side of the kink, from which Newton converges quadratically.
     """
     _, px, py, pw, _, _, _, _ = kernel
-    facet = np.empty(3)
-    facet[0], facet[1], facet[2] = py[k], -px[k], 1.0
-    power = load[0] * facet[0] + load[1] * facet[1] + load[2]
-    if power == 0.0:
-        return 0.0
-    facet /= power
-    local = np.empty(10)
-    rest = np.empty(10)
-    _terms(kernel, 0.0, facet, True, local, rest)
     m00 = b1[0] - b1[2] * py[k]
     m10 = b1[1] + b1[2] * px[k]
     m01 = b2[0] - b2[2] * py[k]
@@ -408,9 +401,9 @@ def _solve_load(kernel, discrete, load, units, scale, twist):  # pragma: no cove
         if stalled or speed[0] <= NEAR_KINK * safety:
             safety, on_facet = _facets(kernel, load, scale, twist, safety)
         if stalled and not on_facet:
-            escaped = scale * _escape_kink(kernel, load, twist, b1, b2, index[0])
-            if escaped > 0.0 and escaped <= safety:
-                return escaped, 0.0
+            certified = _certify_kink(kernel, load, scale, twist, b1, b2, index[0])
+            if certified > 0.0:
+                return certified, 0.0
             safety = _continuation(kernel, units, scale, twist, safety, b1, b2)
             safety, on_facet = _facets(kernel, load, scale, twist, safety)
     if not stalled or on_facet:
