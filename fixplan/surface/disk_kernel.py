@@ -168,7 +168,7 @@ class DiskKernel(SupportKernel):
         force[outside] = big_f - 2.0 * x * dbig_f
         moment[outside] = 2.0 * radius**2 * wo * dbig_f / a
         if with_hessian:
-            with np.errstate(divide="ignore", invalid="ignore"):  # a ring's rim: infinite
+            with np.errstate(divide="ignore", invalid="ignore"):  # infinite on a ring's rim
                 d2big_f = hyp2f1(1.5, 1.5, c + 2.0, x) / (16.0 * c * (c + 1.0))
                 q = dbig_f + 2.0 * x * d2big_f
             h_aa[outside] = 2.0 * x * q / a
@@ -202,21 +202,20 @@ class DiskKernel(SupportKernel):
         if not with_hessian:
             return h, loads, None
         hess = np.empty((len(twists), 3, 3))
-        across = h_aa - ratio
-        hess[:, 0, 0] = ratio + _times(across, ex * ex)
-        hess[:, 1, 1] = ratio + _times(across, ey * ey)
-        hess[:, 0, 1] = hess[:, 1, 0] = _times(across, ex * ey)
-        hess[:, 0, 2] = hess[:, 2, 0] = _times(h_aw, ex)
-        hess[:, 1, 2] = hess[:, 2, 1] = _times(h_aw, ey)
-        hess[:, 2, 2] = h_ww
+        with np.errstate(invalid="ignore"):  # inf * 0 on a ring's rim: replaced below
+            across = h_aa - ratio
+            hess[:, 0, 0] = ratio + across * ex * ex
+            hess[:, 1, 1] = ratio + across * ey * ey
+            hess[:, 0, 1] = hess[:, 1, 0] = across * ex * ey
+            hess[:, 0, 2] = hess[:, 2, 0] = h_aw * ex
+            hess[:, 1, 2] = hess[:, 2, 1] = h_aw * ey
+            hess[:, 2, 2] = h_ww
+        # A thin ring rotating about one of its points is infinitely curved there: central
+        # differences of the gradient give Newton a finite Hessian to steer by.
+        singular = ~np.all(np.isfinite(hess), axis=(1, 2))
+        if np.any(singular):
+            hess[singular] = SupportKernel.hessian(self, twists[singular])
         return h, loads, hess
-
-
-def _times(curvature: np.ndarray, direction: np.ndarray) -> np.ndarray:
-    """``curvature * direction`` with 0 where ``direction`` is 0, also for an infinite
-    curvature (a ring rotating about one of its points)."""
-    with np.errstate(invalid="ignore"):
-        return np.where(direction == 0.0, 0.0, curvature * direction)
 
 
 @dataclass(frozen=True, slots=True)
