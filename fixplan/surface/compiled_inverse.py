@@ -10,6 +10,12 @@ Kernels are passed as a tuple ``(kind, x, y, weights, edges, reach, transform, p
 ``x``, ``y`` [m] with friction ``weights`` (the far-field rule of a polygon), the polygon's edge
 table ``(7, E)`` and its far-field radius ``reach`` [m] (``kind`` :data:`EDGES`), and the
 ``transform`` (3x3) from contact-frame to local twists when ``posed``.
+
+The per-twist terms come from :mod:`~fixplan.surface.point_kernel` and
+:mod:`~fixplan.surface.polygon_kernel`. numba keys its on-disk cache by each compiled function's
+own file, so after editing those modules in a working copy, delete the cache folder
+(:func:`~fixplan.surface.point_kernel.user_cache_dir`): the cached loops here would keep the old
+terms. (Installing a new version replaces every file, which invalidates the whole cache.)
 """
 
 from __future__ import annotations
