@@ -375,11 +375,15 @@ def _plane(load, units, twist, b1, b2):  # pragma: no cover - compiled
     for i in (1, 2):
         if abs(d[i]) < abs(d[axis]):
             axis = i
-    helper = np.zeros(3)
-    helper[axis] = 1.0
-    e1 = np.cross(d, helper)
+    # e1 = d × (unit vector along the axis of d's smallest component), e2 = d × e1.
+    e1 = np.zeros(3)
+    e1[(axis + 1) % 3] = d[(axis + 2) % 3]
+    e1[(axis + 2) % 3] = -d[(axis + 1) % 3]
     e1 /= math.sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2])
-    e2 = np.cross(d, e1)
+    e2 = np.empty(3)
+    e2[0] = d[1] * e1[2] - d[2] * e1[1]
+    e2[1] = d[2] * e1[0] - d[0] * e1[2]
+    e2[2] = d[0] * e1[1] - d[1] * e1[0]
     for i in range(3):
         b1[i] = e1[i] / units[i]
         b2[i] = e2[i] / units[i]
@@ -518,15 +522,18 @@ def compile_kernel(kernel: SupportKernel) -> CompiledKernel | None:
         return CompiledKernel(parts=parts, discrete=kernel.discrete, work=len(kernel.weights))
     if isinstance(kernel, EdgeSumKernel):
         reach = FAR_FIELD_RADII * kernel.size
-        parts = (EDGES, *_point_columns(kernel.far), kernel.edge_table, reach, transform, posed)
+        edges = np.array(kernel.edge_table, dtype=float)
+        parts = (EDGES, *_point_columns(kernel.far), edges, reach, transform, posed)
         return CompiledKernel(parts=parts, discrete=False, work=kernel.edge_table.shape[1])
     return None
 
 
 def _point_columns(kernel: PointSetKernel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Copies (writable, contiguous: every kernel then has the same numba types, compiled once)
+    of the points' x, y [m] and weights."""
     points = np.asarray(kernel.points, dtype=float)
     return (
-        np.ascontiguousarray(points[:, 0]),
-        np.ascontiguousarray(points[:, 1]),
-        np.ascontiguousarray(kernel.weights, dtype=float),
+        np.array(points[:, 0], dtype=float),
+        np.array(points[:, 1], dtype=float),
+        np.array(kernel.weights, dtype=float),
     )
