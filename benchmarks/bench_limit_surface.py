@@ -231,9 +231,12 @@ def measure_per_call(count: int, batch_repeats: int) -> dict:
                 "failed": int(count - len(solved)),
             }
     for key, surface, solved in batches:
-        batch = median_time(
-            lambda s=surface, x=solved: s.motion_and_safety_factor(x), batch_repeats
-        )
+        try:
+            batch = median_time(
+                lambda s=surface, x=solved: s.motion_and_safety_factor(x), batch_repeats
+            )
+        except ConvergenceError:  # a batch may fail on a load that single calls solve
+            batch = np.nan
         results[key]["throughput"] = len(solved) / batch
     return results
 
@@ -252,7 +255,10 @@ def baseline_per_call(ref: str, count: int, batch_repeats: int) -> dict | None:
         subprocess.run(["tar", "-x", "-C", folder], input=archive, check=True)
         env = {**os.environ, "PYTHONPATH": folder, "NUMBA_CACHE_DIR": f"{folder}/numba-cache"}
         command = [sys.executable, __file__, "--measure-per-call", str(count), str(batch_repeats)]
-        output = subprocess.run(command, env=env, cwd=folder, check=True, capture_output=True)
+        output = subprocess.run(command, env=env, cwd=folder, capture_output=True, text=True)
+        if output.returncode:
+            print(f"  (no baseline: the run on {ref} failed)\n{output.stderr}", file=sys.stderr)
+            return None
         return json.loads(output.stdout)
 
 
@@ -278,6 +284,8 @@ def bench_per_call(count: int, batch_repeats: int, ref: str) -> None:
                      f"{was['throughput']:10.0f} {was['median'] / row['median']:8.1f} {gap:11.1e}")  # fmt: skip
             if was["failed"]:
                 line += f"  (was: {was['failed']} ConvergenceError)"
+            if np.isnan(was["throughput"]):
+                line += "  (was: the batch raised ConvergenceError)"
         if row["failed"]:
             line += f"  ({row['failed']} ConvergenceError)"
         print(line)
