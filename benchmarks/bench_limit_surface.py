@@ -4,8 +4,9 @@ Run: ``python benchmarks/bench_limit_surface.py`` (add ``--quick`` for a smaller
 medians of repeated runs; the machines are shared and noisy, so compare ratios.
 
 The inverse map per call is measured against another version of fixplan in the same run
-(``--baseline REF``, default ``main``): that commit is extracted with ``git archive`` into a
-temporary folder and the same measurements run there in a subprocess (its own numba cache).
+(``--baseline REF``, default :data:`BEFORE_COMPILED_INVERSE`, the last commit before it was
+compiled whole): that commit is extracted with ``git archive`` into a temporary folder and the
+same measurements run there in a subprocess (its own numba cache).
 """
 
 from __future__ import annotations
@@ -25,6 +26,9 @@ from pathlib import Path
 import numpy as np
 
 from fixplan import LimitSurface, pressure
+
+#: The last commit whose inverse map ran Newton from Python (issue 13 §3 measured against it).
+BEFORE_COMPILED_INVERSE = "915beafb37c5e1e1b863a49ccea6d0065ac5d6c7"
 
 
 def median_time(function, repeats: int) -> float:
@@ -294,7 +298,9 @@ def bench_per_call(count: int, batch_repeats: int, ref: str) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="smaller sizes (for CI)")
-    parser.add_argument("--baseline", default="main", help="git ref of the per-call baseline")
+    parser.add_argument(
+        "--baseline", default=BEFORE_COMPILED_INVERSE, help="git ref of the per-call baseline"
+    )
     parser.add_argument("--measure-per-call", nargs=2, type=int, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.measure_per_call:
