@@ -2,18 +2,33 @@
 
 Run: ``python benchmarks/bench_limit_surface.py`` (add ``--quick`` for a smaller run). Prints
 medians of repeated runs; the machines are shared and noisy, so compare ratios.
+
+The inverse map per call is measured against another version of fixplan in the same run
+(``--baseline REF``, default :data:`BEFORE_COMPILED_INVERSE`, the last commit before it was
+compiled whole): that commit is extracted with ``git archive`` into a temporary folder and the
+same measurements run there in a subprocess (its own numba cache).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import json
+import os
 import resource
+import subprocess
+import sys
+import tempfile
 import time
 import warnings
+from pathlib import Path
 
 import numpy as np
 
 from fixplan import LimitSurface, pressure
+
+#: The last commit whose inverse map ran Newton from Python (issue 13 §3 measured against it).
+BEFORE_COMPILED_INVERSE = "915beafb37c5e1e1b863a49ccea6d0065ac5d6c7"
 
 
 def median_time(function, repeats: int) -> float:
@@ -153,16 +168,152 @@ def bench_accuracy() -> None:
             print(f"  {name:16s} {order:5d} {len(xy):8d} {error:9.1e}")
 
 
+def per_call_surfaces() -> dict:
+    """The surfaces of the per-call benchmark: point supports (facets), a polygon, a disk."""
+    xy = np.random.default_rng(1).uniform(-0.05, 0.05, size=(4096, 2))
+    triangle = 0.05 * np.array([[0.0, 1.0], [-0.866, -0.5], [0.866, -0.5]])
+    return {
+        "4,096 points": LimitSurface(pressure.points(xy), mu=0.5, normal_force=100.0),
+        "3 points": LimitSurface(pressure.points(triangle), mu=0.5, normal_force=30.0),
+        "rectangle 10:1": LimitSurface(pressure.rectangle(0.1, 0.01), mu=0.25, normal_force=200.0),
+        "uniform disk": LimitSurface(pressure.disk(0.01), mu=0.5, normal_force=10.0),
+    }
+
+
+def load_distributions(surface, count: int, rng) -> dict:
+    """name: loads ``(count, 3)`` [N, N m] of each distribution of the per-call benchmark."""
+    rho = surface.characteristic_length
+    twists = rng.normal(size=(count, 3)) * [1.0, 1.0, 1.0 / rho]
+    directions = rng.normal(size=(count, 3)) * [1.0, 1.0, rho]
+    on_surface = surface.load(twists)
+    loads = {
+        "from twists (h's gradient)": on_surface,
+        "random directions and sizes": directions
+        * surface.max_force
+        * rng.uniform(0.01, 100.0, (count, 1)),
+        "near pure moment": surface.load([0.0, 0.0, 1.0]) * rng.uniform(0.5, 2.0, (count, 1))
+        + directions * 1e-6 * surface.max_force,
+        "far outside (x 1e6)": on_surface * 1e6,
+        "deep inside (x 1e-6)": on_surface * 1e-6,
+    }
+    points = getattr(surface.field, "xy", None)
+    if points is not None:
+        k = rng.integers(0, len(points), count)
+        offsets = rng.normal(size=(count, 2)) * 1e-7 * rho
+        near = surface.load_at_cor(points[k] + offsets) * rng.uniform(0.5, 1.5, (count, 1))
+        loads["near facets (COR 1e-7 rho off a point)"] = near
+    return loads
+
+
+def measure_per_call(count: int, batch_repeats: int) -> dict:
+    """Single-call median and p99 [s], batched throughput [queries/s], the safety factors (NaN
+    where the version raised ConvergenceError) and the number of such failures, per surface and
+    load distribution (public API only: it runs on other versions too). Single calls are timed
+    before any batch: the threads of a parallel batch keep spinning for a while afterwards."""
+    from fixplan import ConvergenceError
+
+    results = {}
+    batches = []
+    for name, surface in per_call_surfaces().items():
+        rng = np.random.default_rng(2)
+        for distribution, loads in load_distributions(surface, count, rng).items():
+            surface.motion_and_safety_factor(loads[0])  # compile, warm up
+            times = np.empty(count)
+            safety = np.full(count, np.nan)
+            for i, load in enumerate(loads):
+                start = time.perf_counter()
+                with contextlib.suppress(ConvergenceError):
+                    safety[i] = surface.motion_and_safety_factor(load)[1]
+                times[i] = time.perf_counter() - start
+            key = f"{name} | {distribution}"
+            solved = loads[~np.isnan(safety)]
+            batches.append((key, surface, solved))
+            results[key] = {
+                "median": float(np.median(times)),
+                "p99": float(np.percentile(times, 99)),
+                "safety": safety.tolist(),
+                "failed": int(count - len(solved)),
+            }
+    for key, surface, solved in batches:
+        try:
+            batch = median_time(
+                lambda s=surface, x=solved: s.motion_and_safety_factor(x), batch_repeats
+            )
+        except ConvergenceError:  # a batch may fail on a load that single calls solve
+            batch = np.nan
+        results[key]["throughput"] = len(solved) / batch
+    return results
+
+
+def baseline_per_call(ref: str, count: int, batch_repeats: int) -> dict | None:
+    """:func:`measure_per_call` run on commit ``ref`` of this repository (``None`` if it cannot
+    be extracted)."""
+    root = Path(__file__).resolve().parent.parent
+    with tempfile.TemporaryDirectory() as folder:
+        try:
+            archive = subprocess.run(["git", "-C", str(root), "archive", ref], check=True,
+                                     capture_output=True).stdout  # fmt: skip
+        except (OSError, subprocess.CalledProcessError) as exc:
+            print(f"  (no baseline: git archive {ref} failed: {exc})", file=sys.stderr)
+            return None
+        subprocess.run(["tar", "-x", "-C", folder], input=archive, check=True)
+        env = {**os.environ, "PYTHONPATH": folder, "NUMBA_CACHE_DIR": f"{folder}/numba-cache"}
+        command = [sys.executable, __file__, "--measure-per-call", str(count), str(batch_repeats)]
+        output = subprocess.run(command, env=env, cwd=folder, capture_output=True, text=True)
+        if output.returncode:
+            print(f"  (no baseline: the run on {ref} failed)\n{output.stderr}", file=sys.stderr)
+            return None
+        return json.loads(output.stdout)
+
+
+def bench_per_call(count: int, batch_repeats: int, ref: str) -> None:
+    """The inverse map per call and batched, per load distribution, against commit ``ref``."""
+    new = measure_per_call(count, batch_repeats)
+    old = baseline_per_call(ref, count, batch_repeats)
+    print(f"inverse map per call (motion_and_safety_factor), {count} loads per distribution;")
+    print(f"  this version against {ref} in the same run (median | p99 per call; batch of {count})")
+    header = f"  {'surface | loads':58s} {'median':>8s} {'p99':>8s} {'batch q/s':>10s}"
+    if old is not None:
+        header += f" {'was median':>10s} {'p99':>8s} {'batch q/s':>10s} {'x median':>8s} {'safety diff':>11s}"
+    print(header)
+    for key, row in new.items():
+        line = (f"  {key:58s} {row['median'] * 1e6:6.1f}us {row['p99'] * 1e6:6.1f}us "
+                f"{row['throughput']:10.0f}")  # fmt: skip
+        if old is not None and key in old:
+            was = old[key]
+            a, b = np.array(row["safety"]), np.array(was["safety"])
+            finite = np.isfinite(a) & np.isfinite(b)
+            gap = np.max(np.abs(a[finite] - b[finite]) / b[finite]) if finite.any() else 0.0
+            line += (f" {was['median'] * 1e6:8.1f}us {was['p99'] * 1e6:6.1f}us "
+                     f"{was['throughput']:10.0f} {was['median'] / row['median']:8.1f} {gap:11.1e}")  # fmt: skip
+            if was["failed"]:
+                line += f"  (was: {was['failed']} ConvergenceError)"
+            if np.isnan(was["throughput"]):
+                line += "  (was: the batch raised ConvergenceError)"
+        if row["failed"]:
+            line += f"  ({row['failed']} ConvergenceError)"
+        print(line)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="smaller sizes (for CI)")
+    parser.add_argument(
+        "--baseline", default=BEFORE_COMPILED_INVERSE, help="git ref of the per-call baseline"
+    )
+    parser.add_argument("--measure-per-call", nargs=2, type=int, help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.measure_per_call:
+        json.dump(measure_per_call(*args.measure_per_call), sys.stdout)
+        return
     if args.quick:
         bench_forward(2000, 2000, 3)
         bench_inverse(4096, 500, 3, 3)
+        bench_per_call(200, 3, args.baseline)
     else:
         bench_forward(10_000, 10_000, 5)
         bench_inverse(4096, 4000, 20, 5)
+        bench_per_call(1000, 5, args.baseline)
     bench_accuracy()
 
 

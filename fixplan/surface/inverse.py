@@ -21,7 +21,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fixplan.errors import ConvergenceError
+from fixplan.surface.compiled_inverse import (
+    CRAWL,
+    FACETS_TESTED,
+    MAX_HALVINGS,
+    NEAR_KINK,
+    QUADRATIC_REGION,
+    RIDGE,
+    SMOOTHING_STAGES,
+    not_converged,
+)
 from fixplan.surface.kernels import SupportKernel
 from fixplan.surface.point_kernel import slowest_points
 from fixplan.tolerances import (
@@ -30,26 +39,6 @@ from fixplan.tolerances import (
     INVERSE_MAX_ITERATIONS,
     INVERSE_RTOL,
 )
-
-#: Number of nearest support points whose facets are tested per query.
-_FACETS_TESTED = 3
-
-#: Newton decrement (relative to h) below which full steps are taken without a line search:
-#: there the iteration is quadratic and rounding would defeat the sufficient-decrease test.
-QUADRATIC_REGION = 1e-12
-
-#: A support point whose weighted speed is below this fraction of h sits on a possible kink.
-_NEAR_KINK = 1e-6
-
-#: Smoothing speeds (relative to the translation speed of the twist) of the continuation that
-#: takes over where Newton stalls at a kink.
-_SMOOTHING_STAGES = (1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
-
-#: A Newton step damped below this fraction signals a kink: Newton stops there.
-_CRAWL = 1e-3
-
-#: Most step halvings of the backtracking line search.
-_MAX_HALVINGS = 60
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,7 +69,7 @@ def _newton_step(g, hess, b1, b2):
     h11 = np.einsum("ij,ij->i", b1, hb1)
     h12 = np.einsum("ij,ij->i", b1, hb2)
     h22 = np.einsum("ij,ij->i", b2, hb2)
-    ridge = 1e-14 * np.abs(h11 + h22) + 1e-300
+    ridge = RIDGE * np.abs(h11 + h22) + 1e-300
     h11, h22 = h11 + ridge, h22 + ridge
     det = h11 * h22 - h12 * h12
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -107,7 +96,7 @@ def _newton(z, e1, e2, active, terms, values, *, kinks: bool = False) -> np.ndar
         # Near the minimum the sufficient decrease is below rounding: full steps are taken.
         accepted = done | (decrement <= QUADRATIC_REGION * h)
         t = np.ones(len(active))
-        for _ in range(_MAX_HALVINGS):
+        for _ in range(MAX_HALVINGS):
             idx = np.flatnonzero(~accepted)
             if idx.size == 0:
                 break
@@ -119,7 +108,7 @@ def _newton(z, e1, e2, active, terms, values, *, kinks: bool = False) -> np.ndar
         z[active[moved]] = za[moved] + t[moved, None] * step[moved]
         # With point supports, tiny accepted steps mean Newton is crawling into a kink: stop
         # and let the facet test and the smoothing continuation take over.
-        crawling = moved & (t < _CRAWL) if kinks else np.zeros_like(moved)
+        crawling = moved & (t < CRAWL) if kinks else np.zeros_like(moved)
         stalled[active[~accepted | crawling]] = True
         active = active[moved & ~crawling]
     stalled[active] = True
@@ -132,7 +121,8 @@ def solve(
     """Safety factor and sliding twist of nonzero ``loads`` ``(K, 3)``.
 
     ``scale`` multiplies the kernel (``mu * N``), ``units`` = ``(max_force, max_force,
-    max_moment)`` normalise the coordinates.
+    max_moment)`` normalise the coordinates. Kernels with a compiled form take
+    :class:`~fixplan.surface.compiled_inverse.CompiledKernel` instead.
     """
     points, friction = kernel.facets
     if len(loads) == 1 and len(points) == 0:
@@ -153,7 +143,7 @@ def solve(
     if len(points):
         # Newton only stops short, or lands on a kink, next to a support point.
         _, slowest = slowest_points(points, friction, z / units, 1)
-        near_kink = slowest[:, 0] <= _NEAR_KINK * safety
+        near_kink = slowest[:, 0] <= NEAR_KINK * safety
         rows = np.flatnonzero(stalled | near_kink)
         on_facet = _facets(kernel, scale, loads, units, z, safety, points, friction, rows)
         retry = np.flatnonzero(stalled & ~on_facet)
@@ -195,7 +185,7 @@ def _solve_one(kernel: SupportKernel, load: np.ndarray, units: np.ndarray):
         # Near the minimum the sufficient decrease is below rounding: full steps are taken.
         if decrement > QUADRATIC_REGION * h and terms[0] > h - 1e-4 * decrement:
             t = 0.5
-            for _ in range(_MAX_HALVINGS - 1):
+            for _ in range(MAX_HALVINGS - 1):
                 trial = [x + t * dx for x, dx in zip(twist, step, strict=True)]
                 if float(kernel.support(np.array([trial]))[0]) <= h - 1e-4 * t * decrement:
                     break
@@ -208,7 +198,7 @@ def _solve_one(kernel: SupportKernel, load: np.ndarray, units: np.ndarray):
     if stalled:
         g1, g2 = _projected(g, hess, b1, b2)[:2]
         if math.hypot(g1, g2) > INVERSE_GRADIENT_RTOL * h:
-            raise _not_converged(load, math.hypot(g1, g2) / h)
+            raise not_converged(load, math.hypot(g1, g2) / h)
     return h, np.array(twist)
 
 
@@ -245,7 +235,7 @@ def _plane_basis_one(direction: list[float]) -> tuple[list[float], list[float]]:
 def _newton_step_one(g1, g2, h11, h12, h22) -> tuple[tuple[float, float], float]:
     """:func:`_newton_step` of one point from its projected gradient and Hessian: the step in
     plane coordinates and the decrement."""
-    ridge = 1e-14 * abs(h11 + h22) + 1e-300
+    ridge = RIDGE * abs(h11 + h22) + 1e-300
     h11, h22 = h11 + ridge, h22 + ridge
     det = h11 * h22 - h12 * h12
     if det > 0.0:
@@ -266,18 +256,7 @@ def _check_converged(z, e1, e2, loads, terms) -> None:
     projected = np.hypot(np.einsum("ij,ij->i", g, e1), np.einsum("ij,ij->i", g, e2))
     bad = np.flatnonzero(projected > INVERSE_GRADIENT_RTOL * h)
     if bad.size:
-        raise _not_converged(loads[bad[0]], projected[bad[0]] / h[bad[0]])
-
-
-def _not_converged(load: np.ndarray, relative_gradient: float) -> ConvergenceError:
-    """The error of a load where Newton stopped away from a minimum."""
-    return ConvergenceError(
-        f"the inverse map did not converge for load {load.tolist()} (relative gradient "
-        f"{relative_gradient:.2g}). Pressure and friction functions must be smooth over the "
-        "patch: where mu or p jumps or has a kink (two materials, a step in pressure), describe "
-        "each smooth region as its own patch and sum them with LimitSurface.combine. Otherwise, "
-        "please report this load."
-    )
+        raise not_converged(loads[bad[0]], projected[bad[0]] / h[bad[0]])
 
 
 def _facets(kernel, scale, loads, units, z, safety, points, friction, rows) -> np.ndarray:
@@ -289,7 +268,7 @@ def _facets(kernel, scale, loads, units, z, safety, points, friction, rows) -> n
     on_facet = np.zeros(len(loads), dtype=bool)
     if rows.size == 0:
         return on_facet
-    nearest, _ = slowest_points(points, friction, z[rows] / units, _FACETS_TESTED)
+    nearest, _ = slowest_points(points, friction, z[rows] / units, FACETS_TESTED)
     for column in range(nearest.shape[1]):
         k = nearest[:, column]
         px, py = points[k, 0], points[k, 1]
@@ -339,7 +318,7 @@ def _continuation(kernel, scale, units, z, safety, e1, e2, rows) -> None:
     the lower ``h`` is the better answer). ``z`` and ``safety`` are updated in place.
     """
     start = z[rows].copy()
-    for eta in _SMOOTHING_STAGES:
+    for eta in SMOOTHING_STAGES:
         terms, values = _objective(kernel.smoothed(eta / units[0]), scale, units)
         _newton(z, e1, e2, rows, terms, values)
     terms, values = _objective(kernel, scale, units)

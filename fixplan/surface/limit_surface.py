@@ -36,6 +36,7 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError
+from fixplan.surface.compiled_inverse import compile_kernel
 from fixplan.surface.disk_kernel import AnnulusKernel, DiskKernel
 from fixplan.surface.geometry import Pose, triangulate
 from fixplan.surface.inverse import solve
@@ -86,7 +87,17 @@ class LimitSurface:
         Total normal force [N], > 0.
     """
 
-    __slots__ = ("_kernel", "_mu", "_normal_force", "_parts", "_scale", "_shape", "_units", "field")
+    __slots__ = (
+        "_compiled",
+        "_kernel",
+        "_mu",
+        "_normal_force",
+        "_parts",
+        "_scale",
+        "_shape",
+        "_units",
+        "field",
+    )
 
     def __init__(self, field: PressureField, *, mu: float | Callable, normal_force: float = 1.0):
         if not isinstance(field, PressureField):
@@ -115,6 +126,7 @@ class LimitSurface:
         self, kernel: SupportKernel, scale: float, shape: LimitSurface | None = None
     ) -> None:
         self._kernel = kernel
+        self._compiled = compile_kernel(kernel)
         self._scale = scale
         self._shape = shape
         probe = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
@@ -232,6 +244,8 @@ class LimitSurface:
             # Frictionless: only the load 0 is held; the motion is the limit mu -> 0+.
             safety = np.where(np.any(loads != 0.0, axis=1), 0.0, np.inf)
             return safety, self._shape._inverse(loads)[1], single
+        if self._compiled is not None:
+            return (*self._compiled.solve(loads, self._units, self._scale), single)
         if single and zero is None:
             # Solve for a load of unit size (normalised): s(c L) = s(L) / c.
             size = float(np.max(np.abs(loads[0] / self._units)))
@@ -284,7 +298,11 @@ class LimitSurface:
         return self._unit_twists(twists), safety
 
     def _unit_twists(self, twists: np.ndarray) -> np.ndarray:
-        scaled = twists * np.array([1.0, 1.0, self.characteristic_length])
+        rho = self.characteristic_length
+        if twists.ndim == 1:  # one query: floats cost less than NumPy calls
+            vx, vy, w = twists.tolist()
+            return twists / math.sqrt(vx * vx + vy * vy + (rho * w) ** 2)
+        scaled = twists * np.array([1.0, 1.0, rho])
         return twists / np.linalg.norm(scaled, axis=-1, keepdims=True)
 
     # -- plotting and fitting -----------------------------------------------------------------

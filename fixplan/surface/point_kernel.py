@@ -24,85 +24,121 @@ from fixplan.surface.kernels import SupportKernel
 #: (one point of the facet) instead of a unit force in the direction of rounding noise.
 STATIONARY_RTOL = 1e-12
 
-_JIT = {"fastmath": {"reassoc", "contract"}, "nogil": True}
+_JIT = {"fastmath": {"reassoc", "contract"}, "nogil": True, "error_model": "numpy"}
 
 
-def _evaluate(px, py, pw, eps2, twists, out_h, out_loads):  # pragma: no cover - compiled
-    for k in numba.prange(twists.shape[0]):
-        vx, vy, w = twists[k, 0], twists[k, 1], twists[k, 2]
-        h = 0.0
-        fx = 0.0
-        fy = 0.0
-        m = 0.0
-        for i in range(px.shape[0]):
-            ux = vx - w * py[i]
-            uy = vy + w * px[i]
-            speed = math.sqrt(ux * ux + uy * uy + eps2)
-            if speed > STATIONARY_RTOL * (abs(vx) + abs(vy) + abs(w) * (abs(px[i]) + abs(py[i]))):
-                s = pw[i] / speed
-                h += pw[i] * speed
-                gx = s * ux
-                gy = s * uy
-                fx += gx
-                fy += gy
-                m += px[i] * gy - py[i] * gx
-        out_h[k] = h
-        out_loads[k, 0] = fx
-        out_loads[k, 1] = fy
-        out_loads[k, 2] = m
+def point_terms(px, py, pw, eps2, vx, vy, w, with_hessian, out):  # pragma: no cover - compiled
+    """Support value, gradient and (``with_hessian``) Hessian at one twist ``(vx, vy, w)``,
+    written to ``out`` ``(10,)``: ``h``, ``g`` (3), then ``H`` 00, 01, 02, 11, 12, 22.
 
-
-def _newton_terms(px, py, pw, eps2, twists, out_h, out_g, out_hess):  # pragma: no cover
-    for k in numba.prange(twists.shape[0]):
-        vx, vy, w = twists[k, 0], twists[k, 1], twists[k, 2]
-        h = 0.0
-        g0 = 0.0
-        g1 = 0.0
-        g2 = 0.0
-        h00 = 0.0
-        h01 = 0.0
-        h02 = 0.0
-        h11 = 0.0
-        h12 = 0.0
-        h22 = 0.0
+    With ``s = sqrt(|u|² + eps²)``, ``A = [[1, 0, -y], [0, 1, x]]`` and ``e = u / s``:
+    ``ds/dV = Aᵀ e``, ``d²s/dV² = Aᵀ (I - e eᵀ) A / s``. The loops are free of branches (a
+    stationary point is masked out by a zero weight) so that they vectorise.
+    """
+    base = abs(vx) + abs(vy)
+    spin = abs(w)
+    h = 0.0
+    g0 = 0.0
+    g1 = 0.0
+    g2 = 0.0
+    if not with_hessian:
         for i in range(px.shape[0]):
             x = px[i]
             y = py[i]
             ux = vx - w * y
             uy = vy + w * x
             speed = math.sqrt(ux * ux + uy * uy + eps2)
-            if speed > STATIONARY_RTOL * (abs(vx) + abs(vy) + abs(w) * (abs(x) + abs(y))):
-                # With s = sqrt(|u|² + eps²), A = [[1, 0, -y], [0, 1, x]] and e = u / s:
-                # ds/dV = A^T e, d²s/dV² = A^T (I - e e^T) A / s.
-                c = pw[i] / speed
-                ex = ux / speed
-                ey = uy / speed
-                h += pw[i] * speed
-                g0 += pw[i] * ex
-                g1 += pw[i] * ey
-                g2 += pw[i] * (x * ey - y * ex)
-                m00 = c * (1.0 - ex * ex)
-                m01 = -c * ex * ey
-                m11 = c * (1.0 - ey * ey)
-                h00 += m00
-                h01 += m01
-                h11 += m11
-                h02 += -y * m00 + x * m01
-                h12 += -y * m01 + x * m11
-                h22 += y * y * m00 - 2.0 * x * y * m01 + x * x * m11
-        out_h[k] = h
-        out_g[k, 0] = g0
-        out_g[k, 1] = g1
-        out_g[k, 2] = g2
-        out_hess[k, 0, 0] = h00
-        out_hess[k, 0, 1] = h01
-        out_hess[k, 1, 0] = h01
-        out_hess[k, 0, 2] = h02
-        out_hess[k, 2, 0] = h02
-        out_hess[k, 1, 1] = h11
-        out_hess[k, 1, 2] = h12
-        out_hess[k, 2, 1] = h12
-        out_hess[k, 2, 2] = h22
+            moving = speed > STATIONARY_RTOL * (base + spin * (abs(x) + abs(y)))
+            c = pw[i] / speed if moving else 0.0
+            gx = c * ux
+            gy = c * uy
+            h += c * speed * speed
+            g0 += gx
+            g1 += gy
+            g2 += x * gy - y * gx
+        out[0] = h
+        out[1] = g0
+        out[2] = g1
+        out[3] = g2
+        return
+    h00 = 0.0
+    h01 = 0.0
+    h02 = 0.0
+    h11 = 0.0
+    h12 = 0.0
+    h22 = 0.0
+    for i in range(px.shape[0]):
+        x = px[i]
+        y = py[i]
+        ux = vx - w * y
+        uy = vy + w * x
+        speed = math.sqrt(ux * ux + uy * uy + eps2)
+        moving = speed > STATIONARY_RTOL * (base + spin * (abs(x) + abs(y)))
+        inverse = 1.0 / speed if moving else 0.0
+        c = pw[i] * inverse
+        gx = c * ux
+        gy = c * uy
+        h += c * speed * speed
+        g0 += gx
+        g1 += gy
+        g2 += x * gy - y * gx
+        # (I - e eᵀ) / s = [[uy² + eps², -ux uy], [-ux uy, ux² + eps²]] / s³; with r = x ux + y uy
+        # its image under A is as below.
+        q = c * inverse * inverse
+        a = q * ux
+        b = q * uy
+        r = x * ux + y * uy
+        qe = q * eps2
+        h00 += b * uy + qe
+        h01 -= a * uy
+        h11 += a * ux + qe
+        h02 -= b * r + qe * y
+        h12 += a * r + qe * x
+        h22 += q * r * r + qe * (x * x + y * y)
+    out[0] = h
+    out[1] = g0
+    out[2] = g1
+    out[3] = g2
+    out[4] = h00
+    out[5] = h01
+    out[6] = h02
+    out[7] = h11
+    out[8] = h12
+    out[9] = h22
+
+
+def _evaluate(px, py, pw, eps2, twists, out_h, out_loads):  # pragma: no cover - compiled
+    for k in numba.prange(twists.shape[0]):
+        out = np.empty(10)
+        _POINT_TERMS(px, py, pw, eps2, twists[k, 0], twists[k, 1], twists[k, 2], False, out)
+        out_h[k] = out[0]
+        out_loads[k, 0] = out[1]
+        out_loads[k, 1] = out[2]
+        out_loads[k, 2] = out[3]
+
+
+def _newton_terms(px, py, pw, eps2, twists, out_h, out_g, out_hess):  # pragma: no cover
+    for k in numba.prange(twists.shape[0]):
+        out = np.empty(10)
+        _POINT_TERMS(px, py, pw, eps2, twists[k, 0], twists[k, 1], twists[k, 2], True, out)
+        out_h[k] = out[0]
+        out_g[k, 0] = out[1]
+        out_g[k, 1] = out[2]
+        out_g[k, 2] = out[3]
+        _UNPACK_HESSIAN(out, out_hess[k])
+
+
+def unpack_hessian(terms, hess):  # pragma: no cover - compiled
+    """The symmetric 3x3 ``hess`` from the six entries ``terms[4:10]`` of :func:`point_terms`."""
+    hess[0, 0] = terms[4]
+    hess[0, 1] = terms[5]
+    hess[1, 0] = terms[5]
+    hess[0, 2] = terms[6]
+    hess[2, 0] = terms[6]
+    hess[1, 1] = terms[7]
+    hess[1, 2] = terms[8]
+    hess[2, 1] = terms[8]
+    hess[2, 2] = terms[9]
 
 
 #: Below this many (point, twist) pairs a call runs on one thread: waking the thread pool costs
@@ -175,6 +211,16 @@ def _compiled(function):
         )
 
 
+def compiled_scalar(function):
+    """``function`` compiled once, serial, cached like :func:`_compiled`: a building block that
+    compiled loops call per twist."""
+    folder = _writable_cache_dir()
+    with _cached_in(folder):
+        return numba.njit(**_JIT, cache=folder is not None)(function)
+
+
+_POINT_TERMS = compiled_scalar(point_terms)
+_UNPACK_HESSIAN = compiled_scalar(unpack_hessian)
 _EVALUATE = _compiled(_evaluate)
 _NEWTON_TERMS = _compiled(_newton_terms)
 

@@ -37,17 +37,85 @@ import numba
 import numpy as np
 
 from fixplan.surface.kernels import SupportKernel
-from fixplan.surface.point_kernel import PointSetKernel, _compiled, _pick
+from fixplan.surface.point_kernel import (
+    _UNPACK_HESSIAN,
+    PointSetKernel,
+    _compiled,
+    _pick,
+    compiled_scalar,
+)
 from fixplan.tolerances import FAR_FIELD_RADII
+
+
+def edge_terms(edges, vx, vy, w, with_hessian, out):  # pragma: no cover - compiled
+    """Support value, load and (``with_hessian``) Hessian at one twist ``(vx, vy, w)`` with
+    ``w != 0``, written to ``out`` ``(10,)`` as :func:`~fixplan.surface.point_kernel.point_terms`
+    does. ``edges`` ``(7, E)`` holds the starts' x and y, the ends' x and y, the unit
+    directions' x and y and the weights."""
+    cx = -vy / w
+    cy = vx / w
+    moment = 0.0
+    ux = 0.0  # ∫ q û dA = -∇M
+    uy = 0.0
+    m00 = 0.0  # ∇²M
+    m01 = 0.0
+    m11 = 0.0
+    for i in range(edges.shape[1]):
+        q = edges[6, i]
+        dx = edges[4, i]
+        dy = edges[5, i]
+        nx = dy
+        ny = -dx
+        ax = edges[0, i] - cx
+        ay = edges[1, i] - cy
+        d = nx * ax + ny * ay
+        ta = dx * ax + dy * ay
+        tb = dx * (edges[2, i] - cx) + dy * (edges[3, i] - cy)
+        ra = math.sqrt(d * d + ta * ta)
+        rb = math.sqrt(d * d + tb * tb)
+        absd = abs(d)
+        asinh_diff = math.asinh(tb / absd) - math.asinh(ta / absd) if absd > 0.0 else 0.0
+        moment += q * (d / 6.0) * (tb * rb - ta * ra + d * d * asinh_diff)
+        u_n = q * 0.5 * d * d * asinh_diff
+        u_e = q * 0.5 * d * (rb - ra)
+        ux += u_n * nx + u_e * dx
+        uy += u_n * ny + u_e * dy
+        if with_hessian:
+            # t/r and 1/r vanish with d at the vertex itself (r = 0): |d t/r|, d²/r <= |d|.
+            inv_ra = 1.0 / ra if ra > 0.0 else 0.0
+            inv_rb = 1.0 / rb if rb > 0.0 else 0.0
+            c_ee = d * (tb * inv_rb - ta * inv_ra)
+            c_nn = 2.0 * d * asinh_diff - c_ee
+            c_ne = d * d * (inv_rb - inv_ra) + 0.5 * (rb - ra)
+            m00 += 0.5 * q * (c_nn * nx * nx + 2.0 * c_ne * nx * dx + c_ee * dx * dx)
+            m01 += 0.5 * q * (c_nn * nx * ny + c_ne * (nx * dy + dx * ny) + c_ee * dx * dy)
+            m11 += 0.5 * q * (c_nn * ny * ny + 2.0 * c_ne * ny * dy + c_ee * dy * dy)
+    sign = 1.0 if w > 0.0 else -1.0
+    gx = -ux
+    gy = -uy
+    out[0] = abs(w) * moment
+    out[1] = sign * gy
+    out[2] = -sign * gx
+    out[3] = sign * (moment - cx * gx - cy * gy)
+    if with_hessian:
+        s = 1.0 / abs(w)
+        out[4] = s * m11
+        out[5] = -s * m01
+        out[6] = -s * (m01 * cx + m11 * cy)
+        out[7] = s * m00
+        out[8] = s * (m00 * cx + m01 * cy)
+        out[9] = s * (m00 * cx * cx + 2.0 * m01 * cx * cy + m11 * cy * cy)
+
+
+_EDGE_TERMS = compiled_scalar(edge_terms)
 
 
 def _edge_sums(  # pragma: no cover - compiled
     edges, reach, twists, with_hessian, out_h, out_g, out_hess, out_far
 ):
     """Support values ``out_h``, loads ``out_g`` and, ``with_hessian``, Hessians ``out_hess`` of
-    the twists whose centre of rotation lies within ``reach`` [m]; ``out_far`` marks the others
-    (their rows are left unset), whose number is returned. ``edges`` ``(7, E)`` holds the
-    starts' x and y, the ends' x and y, the unit directions' x and y and the weights."""
+    the twists whose centre of rotation lies within ``reach`` [m] (:func:`edge_terms`);
+    ``out_far`` marks the others (their rows are left unset), whose number is returned."""
     far_count = 0
     for k in numba.prange(twists.shape[0]):
         vx, vy, w = twists[k, 0], twists[k, 1], twists[k, 2]
@@ -56,64 +124,14 @@ def _edge_sums(  # pragma: no cover - compiled
         if far:
             far_count += 1
             continue
-        cx = -vy / w
-        cy = vx / w
-        moment = 0.0
-        ux = 0.0  # ∫ q û dA = -∇M
-        uy = 0.0
-        m00 = 0.0  # ∇²M
-        m01 = 0.0
-        m11 = 0.0
-        for i in range(edges.shape[1]):
-            q = edges[6, i]
-            dx = edges[4, i]
-            dy = edges[5, i]
-            nx = dy
-            ny = -dx
-            ax = edges[0, i] - cx
-            ay = edges[1, i] - cy
-            d = nx * ax + ny * ay
-            ta = dx * ax + dy * ay
-            tb = dx * (edges[2, i] - cx) + dy * (edges[3, i] - cy)
-            ra = math.sqrt(d * d + ta * ta)
-            rb = math.sqrt(d * d + tb * tb)
-            absd = abs(d)
-            asinh_diff = math.asinh(tb / absd) - math.asinh(ta / absd) if absd > 0.0 else 0.0
-            moment += q * (d / 6.0) * (tb * rb - ta * ra + d * d * asinh_diff)
-            u_n = q * 0.5 * d * d * asinh_diff
-            u_e = q * 0.5 * d * (rb - ra)
-            ux += u_n * nx + u_e * dx
-            uy += u_n * ny + u_e * dy
-            if with_hessian:
-                # t/r and 1/r vanish with d at the vertex itself (r = 0): |d t/r|, d²/r <= |d|.
-                inv_ra = 1.0 / ra if ra > 0.0 else 0.0
-                inv_rb = 1.0 / rb if rb > 0.0 else 0.0
-                c_ee = d * (tb * inv_rb - ta * inv_ra)
-                c_nn = 2.0 * d * asinh_diff - c_ee
-                c_ne = d * d * (inv_rb - inv_ra) + 0.5 * (rb - ra)
-                m00 += 0.5 * q * (c_nn * nx * nx + 2.0 * c_ne * nx * dx + c_ee * dx * dx)
-                m01 += 0.5 * q * (c_nn * nx * ny + c_ne * (nx * dy + dx * ny) + c_ee * dx * dy)
-                m11 += 0.5 * q * (c_nn * ny * ny + 2.0 * c_ne * ny * dy + c_ee * dy * dy)
-        sign = 1.0 if w > 0.0 else -1.0
-        gx = -ux
-        gy = -uy
-        out_h[k] = abs(w) * moment
-        out_g[k, 0] = sign * gy
-        out_g[k, 1] = -sign * gx
-        out_g[k, 2] = sign * (moment - cx * gx - cy * gy)
+        out = np.empty(10)
+        _EDGE_TERMS(edges, vx, vy, w, with_hessian, out)
+        out_h[k] = out[0]
+        out_g[k, 0] = out[1]
+        out_g[k, 1] = out[2]
+        out_g[k, 2] = out[3]
         if with_hessian:
-            s = 1.0 / abs(w)
-            out_hess[k, 0, 0] = s * m11
-            out_hess[k, 0, 1] = -s * m01
-            out_hess[k, 1, 0] = -s * m01
-            out_hess[k, 1, 1] = s * m00
-            h02 = -s * (m01 * cx + m11 * cy)
-            h12 = s * (m00 * cx + m01 * cy)
-            out_hess[k, 0, 2] = h02
-            out_hess[k, 2, 0] = h02
-            out_hess[k, 1, 2] = h12
-            out_hess[k, 2, 1] = h12
-            out_hess[k, 2, 2] = s * (m00 * cx * cx + 2.0 * m01 * cx * cy + m11 * cy * cy)
+            _UNPACK_HESSIAN(out, out_hess[k])
     return far_count
 
 
@@ -149,6 +167,11 @@ class EdgeSumKernel(SupportKernel):
     @property
     def size(self) -> float:
         return self._size
+
+    @property
+    def edge_table(self) -> np.ndarray:
+        """The edges ``(7, E)`` as :func:`edge_terms` reads them (do not modify)."""
+        return self._edges
 
     def _sums(self, twists, with_hessian):
         twists = np.ascontiguousarray(twists, dtype=float)

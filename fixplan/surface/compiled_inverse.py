@@ -1,0 +1,539 @@
+r"""The inverse map compiled whole, for point sets and piecewise-uniform polygons.
+
+One numba loop per load runs the method of :mod:`fixplan.surface.inverse`: damped Newton on the
+plane ``L·V = 1`` from the ellipsoid's twist, then (point supports) the exact facet tests of the
+slowest support points and, where Newton stalled at a kink that is not a facet, the smoothing
+continuation. The iterates are those of the NumPy path to rounding; only the Python around each
+iteration is gone (a few microseconds per query on a few points instead of half a millisecond).
+
+Kernels are passed as a tuple ``(kind, x, y, weights, edges, reach, transform, posed)``: points
+``x``, ``y`` [m] with friction ``weights`` (the far-field rule of a polygon), the polygon's edge
+table ``(7, E)`` and its far-field radius ``reach`` [m] (``kind`` :data:`EDGES`), and the
+``transform`` (3x3) from contact-frame to local twists when ``posed``.
+
+The per-twist terms come from :mod:`~fixplan.surface.point_kernel` and
+:mod:`~fixplan.surface.polygon_kernel`. numba keys its on-disk cache by each compiled function's
+own file, so after editing those modules in a working copy, delete the cache folder
+(:func:`~fixplan.surface.point_kernel.user_cache_dir`): the cached loops here would keep the old
+terms. (Installing a new version replaces every file, which invalidates the whole cache.)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from fixplan.errors import ConvergenceError
+from fixplan.surface.kernels import PosedKernel, SupportKernel, twist_to_local
+from fixplan.surface.point_kernel import (
+    _POINT_TERMS,
+    PointSetKernel,
+    _compiled,
+    _pick,
+    compiled_scalar,
+)
+from fixplan.surface.polygon_kernel import _EDGE_TERMS, EdgeSumKernel
+from fixplan.tolerances import (
+    FACET_RTOL,
+    FAR_FIELD_RADII,
+    INVERSE_GRADIENT_RTOL,
+    INVERSE_MAX_ITERATIONS,
+    INVERSE_RTOL,
+)
+
+#: Kinds of compiled kernels: weighted points, or polygon edges with a far-field point rule.
+POINTS = 0
+EDGES = 1
+
+#: Number of nearest support points whose facets are tested per query.
+FACETS_TESTED = 3
+
+#: Newton decrement (relative to h) below which full steps are taken without a line search:
+#: there the iteration is quadratic and rounding would defeat the sufficient-decrease test.
+QUADRATIC_REGION = 1e-12
+
+#: A support point whose weighted speed is below this fraction of the safety factor sits on a
+#: possible kink.
+NEAR_KINK = 1e-6
+
+#: Kink handling of :func:`_newton`: none (smooth functions), stop where steps crawl into a
+#: kink, or also stop at the first rejected full step and name the kink it crosses.
+SMOOTH = 0
+CRAWLS = 1
+PROBES = 2
+
+#: Smoothing speeds (relative to the translation speed of the twist) of the continuation that
+#: takes over where Newton stalls at a kink.
+SMOOTHING_STAGES = (1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
+
+#: A Newton step damped below this fraction signals a kink: Newton stops there.
+CRAWL = 1e-3
+
+#: Most step halvings of the backtracking line search.
+MAX_HALVINGS = 60
+
+#: Sufficient decrease of the line search (Armijo constant).
+_ARMIJO = 1e-4
+
+#: The ridge added to the projected Hessian (relative to its trace) keeps it invertible.
+RIDGE = 1e-14
+
+
+def _terms(kernel, eps2, twist, with_hessian, local, out):  # pragma: no cover - compiled
+    """Support value, gradient and (``with_hessian``) Hessian of the unit-friction ``kernel`` at
+    the contact-frame ``twist`` (3,) [m/s, rad/s], in ``out`` (10,) as ``point_terms`` writes
+    them; ``local`` (10,) is scratch. ``eps2`` [m²/s²] smooths the speeds of points."""
+    kind, px, py, pw, edges, reach, transform, posed = kernel
+    vx, vy, w = twist[0], twist[1], twist[2]
+    if posed:
+        t = transform
+        vx, vy, w = (
+            t[0, 0] * twist[0] + t[0, 1] * twist[1] + t[0, 2] * twist[2],
+            t[1, 0] * twist[0] + t[1, 1] * twist[1] + t[1, 2] * twist[2],
+            t[2, 0] * twist[0] + t[2, 1] * twist[1] + t[2, 2] * twist[2],
+        )
+    target = local if posed else out
+    if kind == EDGES and abs(w) * reach > math.sqrt(vx * vx + vy * vy):
+        _EDGE_TERMS(edges, vx, vy, w, with_hessian, target)
+    else:
+        _POINT_TERMS(px, py, pw, eps2, vx, vy, w, with_hessian, target)
+    if not posed:
+        return
+    # g = Tᵀ g_local, H = Tᵀ H_local T.
+    t = transform
+    out[0] = local[0]
+    for i in range(3):
+        out[1 + i] = t[0, i] * local[1] + t[1, i] * local[2] + t[2, i] * local[3]
+    if not with_hessian:
+        return
+    hl = np.empty((3, 3))
+    _unpack(local, hl)
+    for slot, (i, j) in enumerate(((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))):
+        total = 0.0
+        for a in range(3):
+            for b in range(3):
+                total += t[a, i] * hl[a, b] * t[b, j]
+        out[4 + slot] = total
+
+
+def _unpack(terms, hess):  # pragma: no cover - compiled
+    """The symmetric Hessian ``hess`` (3, 3) from ``terms[4:10]``."""
+    hess[0, 0] = terms[4]
+    hess[0, 1] = hess[1, 0] = terms[5]
+    hess[0, 2] = hess[2, 0] = terms[6]
+    hess[1, 1] = terms[7]
+    hess[1, 2] = hess[2, 1] = terms[8]
+    hess[2, 2] = terms[9]
+
+
+def _projected(terms, b1, b2):  # pragma: no cover - compiled
+    """``g·b1``, ``g·b2``, ``b1ᵀ H b1``, ``b1ᵀ H b2`` and ``b2ᵀ H b2`` of ``terms``."""
+    h = np.empty((3, 3))
+    _unpack(terms, h)
+    g1 = terms[1] * b1[0] + terms[2] * b1[1] + terms[3] * b1[2]
+    g2 = terms[1] * b2[0] + terms[2] * b2[1] + terms[3] * b2[2]
+    h11 = 0.0
+    h12 = 0.0
+    h22 = 0.0
+    for i in range(3):
+        for j in range(3):
+            h11 += b1[i] * h[i, j] * b1[j]
+            h12 += b1[i] * h[i, j] * b2[j]
+            h22 += b2[i] * h[i, j] * b2[j]
+    return g1, g2, h11, h12, h22
+
+
+def _newton_step(g1, g2, h11, h12, h22):  # pragma: no cover - compiled
+    """Step ``(s1, s2)`` in plane coordinates and the Newton decrement ``gᵀ H⁻¹ g``; steepest
+    descent where the Hessian is unusable (never at a smooth minimum)."""
+    ridge = RIDGE * abs(h11 + h22) + 1e-300
+    h11 += ridge
+    h22 += ridge
+    det = h11 * h22 - h12 * h12
+    if det > 0.0:
+        s1 = -(h22 * g1 - h12 * g2) / det
+        s2 = -(h11 * g2 - h12 * g1) / det
+        decrement = -(g1 * s1 + g2 * s2)
+        if math.isfinite(decrement) and decrement >= 0.0:
+            return s1, s2, decrement
+    return -g1, -g2, g1 * g1 + g2 * g2
+
+
+def _newton(kernel, eps2, twist, b1, b2, kinks):  # pragma: no cover - compiled
+    """Damped Newton on the plane through ``twist`` spanned by ``b1``, ``b2`` [SI], in place on
+    ``twist``. Returns whether it stalled (no descent, a crawl into a kink unless ``kinks`` is
+    :data:`SMOOTH`, or the iteration limit), the support value at the final ``twist`` and,
+    with ``kinks`` :data:`PROBES`, the support point whose kink the first rejected full step
+    crosses (Newton stops there; else -1)."""
+    local = np.empty(10)
+    current = np.empty(10)
+    new = np.empty(10)
+    step = np.empty(3)
+    trial = np.empty(3)
+    _terms(kernel, eps2, twist, True, local, current)
+    for _ in range(INVERSE_MAX_ITERATIONS):
+        h = current[0]
+        s1, s2, decrement = _newton_step(*_projected(current, b1, b2))
+        if decrement <= INVERSE_RTOL**2 * h:
+            return False, h, -1
+        for i in range(3):
+            step[i] = s1 * b1[i] + s2 * b2[i]
+            trial[i] = twist[i] + step[i]
+        # The full step is tried with the terms of the next iteration: it is nearly always taken.
+        _terms(kernel, eps2, trial, True, local, new)
+        t = 1.0
+        # Near the minimum the sufficient decrease is below rounding: full steps are taken.
+        if decrement > QUADRATIC_REGION * h and new[0] > h - _ARMIJO * decrement:
+            if kinks == PROBES:
+                return True, h, _nearest_kink(kernel, twist, step)
+            accepted = False
+            for _ in range(MAX_HALVINGS - 1):
+                t *= 0.5
+                for i in range(3):
+                    trial[i] = twist[i] + t * step[i]
+                _terms(kernel, eps2, trial, False, local, new)
+                if new[0] <= h - _ARMIJO * t * decrement:
+                    accepted = True
+                    break
+            if not accepted:
+                return True, h, -1
+            _terms(kernel, eps2, trial, True, local, new)
+        twist[:] = trial
+        current[:] = new
+        if kinks != SMOOTH and t < CRAWL:
+            return True, current[0], -1
+    return True, current[0], -1
+
+
+def _slowest(kernel, twist, index, speed):  # pragma: no cover - compiled
+    """Indices ``index`` (n,) of the points with the least weighted speed under ``twist``, and
+    those speeds ``|v_i| * weight_i`` in ``speed``, slowest first."""
+    _, px, py, pw, _, _, _, _ = kernel
+    count = index.shape[0]
+    speed[:] = np.inf
+    index[:] = -1
+    for i in range(px.shape[0]):
+        ux = twist[0] - twist[2] * py[i]
+        uy = twist[1] + twist[2] * px[i]
+        s = math.sqrt(ux * ux + uy * uy) * pw[i]
+        if s < speed[count - 1]:
+            j = count - 1
+            while j > 0 and s < speed[j - 1]:
+                speed[j] = speed[j - 1]
+                index[j] = index[j - 1]
+                j -= 1
+            speed[j] = s
+            index[j] = i
+
+
+def _facet(kernel, load, scale, k, twist, with_hessian, terms):  # pragma: no cover - compiled
+    """The safety factor of ``load`` on the facet of support point ``k``; ``inf`` where the load
+    does not lie on it (the force point ``k`` must carry to balance it is above its friction
+    limit), NaN where the facet is parallel to the load. The facet's twist (on the plane
+    ``L·V = 1``) is left in ``twist`` and the terms of the other points there in ``terms``."""
+    _, px, py, pw, _, _, _, _ = kernel
+    twist[0], twist[1], twist[2] = py[k], -px[k], 1.0
+    power = load[0] * twist[0] + load[1] * twist[1] + load[2]
+    if power == 0.0:
+        return np.nan
+    twist /= power
+    local = np.empty(10)
+    _terms(kernel, 0.0, twist, with_hessian, local, terms)
+    s_k = scale * terms[0]
+    carried = math.hypot(s_k * load[0] - scale * terms[1], s_k * load[1] - scale * terms[2])
+    return s_k if carried <= scale * pw[k] * (1.0 + FACET_RTOL) else np.inf
+
+
+def _facets(kernel, load, scale, twist, safety):  # pragma: no cover - compiled
+    """The safety factor on the facets of the slowest support points where ``load`` lies on
+    one (``twist`` is then set to the facet's twist), else ``safety``; and whether it does."""
+    count = min(FACETS_TESTED, kernel[1].shape[0])
+    index = np.empty(count, dtype=np.int64)
+    speed = np.empty(count)
+    _slowest(kernel, twist, index, speed)
+    facet = np.empty(3)
+    terms = np.empty(10)
+    on_facet = False
+    for k in index:
+        s_k = _facet(kernel, load, scale, k, facet, False, terms)
+        if s_k <= safety * (1.0 + 1e-9):
+            safety = s_k
+            twist[:] = facet
+            on_facet = True
+    return safety, on_facet
+
+
+def _nearest_kink(kernel, twist, step):  # pragma: no cover - compiled
+    """The support point that comes nearest to standing still (least weighted speed) on the
+    segment from ``twist`` to ``twist + step``: the kink a rejected Newton step crosses."""
+    _, px, py, pw, _, _, _, _ = kernel
+    best = np.inf
+    nearest = 0
+    for i in range(px.shape[0]):
+        ux = twist[0] - twist[2] * py[i]
+        uy = twist[1] + twist[2] * px[i]
+        dx = step[0] - step[2] * py[i]
+        dy = step[1] + step[2] * px[i]
+        t = min(max(-(ux * dx + uy * dy) / (dx * dx + dy * dy), 0.0), 1.0)
+        ex = ux + t * dx
+        ey = uy + t * dy
+        speed = (ex * ex + ey * ey) * pw[i] * pw[i]
+        if speed < best:
+            best = speed
+            nearest = i
+    return nearest
+
+
+def _certify_kink(kernel, load, scale, twist, b1, b2, k):  # pragma: no cover - compiled
+    """The safety factor where ``load`` lies on the facet of support point ``k`` or where Newton
+    converges next to its kink (:func:`_escape_kink`), with ``twist`` set to the motion; 0
+    (``twist`` unchanged) otherwise. Either is a certificate: ``h`` is convex on the plane."""
+    facet = np.empty(3)
+    rest = np.empty(10)
+    s_k = _facet(kernel, load, scale, k, facet, True, rest)
+    if s_k < np.inf:
+        twist[:] = facet
+        return s_k
+    if math.isnan(s_k):
+        return 0.0
+    return scale * _escape_kink(kernel, twist, b1, b2, k, facet, rest)
+
+
+def _escape_kink(kernel, twist, b1, b2, k, facet, rest):  # pragma: no cover - compiled
+    r"""Newton's minimum next to the kink of support point ``k`` where the load is not on that
+    point's facet (twist ``facet``, where the other points have the terms ``rest``); ``twist``
+    is set to it. Returns its support value, or 0 (``twist`` unchanged) where Newton does not
+    converge from the start below.
+
+    On the plane, the speed of point ``k`` is ``u = M (α, β)`` (``M`` = ``[A b1, A b2]``,
+    ``A = [[1, 0, -y_k], [0, 1, x_k]]``), zero at the facet's twist ``F``. With the gradient
+    ``G`` and Hessian ``H`` of the other points at ``F`` (``g_u = M⁻ᵀ (G·b1, G·b2)``, larger
+    than the weight ``w_k`` off the facet) the support along ``u = -r ĝ_u`` is
+    ``h(F) - r |g_u| + w_k r + r² dᵀHd / 2``, least at ``r = (|g_u| - w_k) / dᵀHd``: a start
+    on the smooth side of the kink, from which Newton converges quadratically.
+    """
+    _, px, py, pw, _, _, _, _ = kernel
+    m00 = b1[0] - b1[2] * py[k]
+    m10 = b1[1] + b1[2] * px[k]
+    m01 = b2[0] - b2[2] * py[k]
+    m11 = b2[1] + b2[2] * px[k]
+    det = m00 * m11 - m01 * m10
+    g1 = rest[1] * b1[0] + rest[2] * b1[1] + rest[3] * b1[2]
+    g2 = rest[1] * b2[0] + rest[2] * b2[1] + rest[3] * b2[2]
+    gu0 = (m11 * g1 - m10 * g2) / det
+    gu1 = (-m01 * g1 + m00 * g2) / det
+    pull = math.hypot(gu0, gu1)
+    if not pull > pw[k]:
+        return 0.0
+    # Plane direction δ = M⁻¹ û with û = -g_u / |g_u|.
+    d0 = -(m11 * gu0 - m01 * gu1) / (det * pull)
+    d1 = -(-m10 * gu0 + m00 * gu1) / (det * pull)
+    d = d0 * b1 + d1 * b2
+    hess = np.empty((3, 3))
+    _unpack(rest, hess)
+    curvature = 0.0
+    for i in range(3):
+        for j in range(3):
+            curvature += d[i] * hess[i, j] * d[j]
+    if not (curvature > 0.0 and math.isfinite(curvature)):
+        return 0.0
+    start = facet + ((pull - pw[k]) / curvature) * d
+    stalled, h, _ = _newton(kernel, 0.0, start, b1, b2, CRAWLS)
+    if stalled:
+        return 0.0
+    twist[:] = start
+    return h
+
+
+def _continuation(kernel, units, scale, twist, safety, b1, b2):  # pragma: no cover - compiled
+    """Minimise ``h`` where Newton stalled at a kink that is not the minimum: speeds rounded off
+    as ``sqrt(|u|² + eps²)``, ``eps`` reduced stage by stage to zero, each stage starting where
+    the last ended. Keeps the result (``twist`` in place) only where it lowers ``h``; returns
+    the safety factor."""
+    start = twist.copy()
+    for eta in SMOOTHING_STAGES:
+        _newton(kernel, (eta / units[0]) ** 2, twist, b1, b2, SMOOTH)
+    found = scale * _newton(kernel, 0.0, twist, b1, b2, SMOOTH)[1]
+    if found < safety:
+        return found
+    twist[:] = start
+    return safety
+
+
+def _plane(load, units, twist, b1, b2):  # pragma: no cover - compiled
+    """Start ``twist`` (the ellipsoid's, on ``L·V = 1``) and the plane's basis ``b1``, ``b2``
+    (orthonormal in normalised coordinates, divided by ``units``)."""
+    d = np.empty(3)
+    for i in range(3):
+        d[i] = load[i] / units[i]
+    length = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+    d /= length
+    axis = 0
+    for i in (1, 2):
+        if abs(d[i]) < abs(d[axis]):
+            axis = i
+    # e1 = d × (unit vector along the axis of d's smallest component), e2 = d × e1.
+    e1 = np.zeros(3)
+    e1[(axis + 1) % 3] = d[(axis + 2) % 3]
+    e1[(axis + 2) % 3] = -d[(axis + 1) % 3]
+    e1 /= math.sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2])
+    e2 = np.empty(3)
+    e2[0] = d[1] * e1[2] - d[2] * e1[1]
+    e2[1] = d[2] * e1[0] - d[0] * e1[2]
+    e2[2] = d[0] * e1[1] - d[1] * e1[0]
+    for i in range(3):
+        b1[i] = e1[i] / units[i]
+        b2[i] = e2[i] / units[i]
+        twist[i] = d[i] / (length * units[i])
+
+
+def _solve_load(kernel, discrete, load, units, scale, twist):  # pragma: no cover - compiled
+    """Safety factor of one nonzero ``load`` (its sliding twist [SI] in ``twist``) and, where
+    Newton stopped away from a minimum, its projected gradient relative to ``h`` (else 0)."""
+    b1 = np.empty(3)
+    b2 = np.empty(3)
+    _plane(load, units, twist, b1, b2)
+    stalled, h, kink = _newton(kernel, 0.0, twist, b1, b2, PROBES if discrete else SMOOTH)
+    if kink >= 0:
+        certified = _certify_kink(kernel, load, scale, twist, b1, b2, kink)
+        if certified > 0.0:
+            return certified, 0.0
+        stalled, h, _ = _newton(kernel, 0.0, twist, b1, b2, CRAWLS)
+    safety = scale * h
+    on_facet = False
+    if discrete:
+        index = np.empty(1, dtype=np.int64)
+        speed = np.empty(1)
+        _slowest(kernel, twist, index, speed)
+        if stalled or speed[0] <= NEAR_KINK * safety:
+            safety, on_facet = _facets(kernel, load, scale, twist, safety)
+        if stalled and not on_facet:
+            certified = _certify_kink(kernel, load, scale, twist, b1, b2, index[0])
+            if certified > 0.0:
+                return certified, 0.0
+            safety = _continuation(kernel, units, scale, twist, safety, b1, b2)
+            safety, on_facet = _facets(kernel, load, scale, twist, safety)
+    if not stalled or on_facet:
+        return safety, 0.0
+    local = np.empty(10)
+    terms = np.empty(10)
+    _terms(kernel, 0.0, twist, False, local, terms)
+    g1 = terms[1] * b1[0] + terms[2] * b1[1] + terms[3] * b1[2]
+    g2 = terms[1] * b2[0] + terms[2] * b2[1] + terms[3] * b2[2]
+    return safety, math.hypot(g1, g2) / terms[0]
+
+
+def _solve(
+    kernel, discrete, loads, units, scale, out_safety, out_twist, out_gradient
+):  # pragma: no cover
+    for k in numba.prange(loads.shape[0]):
+        # Solve for a load of unit size (normalised): s(c L) = s(L) / c.
+        size = 0.0
+        for i in range(3):
+            size = max(size, abs(loads[k, i] / units[i]))
+        if size == 0.0:
+            out_safety[k] = np.inf
+            out_twist[k, :] = np.nan
+            out_gradient[k] = 0.0
+            continue
+        safety, out_gradient[k] = _solve_load(
+            kernel, discrete, loads[k] / size, units, scale, out_twist[k]
+        )
+        out_safety[k] = safety / size
+
+
+_terms = compiled_scalar(_terms)
+_unpack = compiled_scalar(_unpack)
+_projected = compiled_scalar(_projected)
+_newton_step = compiled_scalar(_newton_step)
+_newton = compiled_scalar(_newton)
+_slowest = compiled_scalar(_slowest)
+_facets = compiled_scalar(_facets)
+_facet = compiled_scalar(_facet)
+_nearest_kink = compiled_scalar(_nearest_kink)
+_escape_kink = compiled_scalar(_escape_kink)
+_certify_kink = compiled_scalar(_certify_kink)
+_continuation = compiled_scalar(_continuation)
+_plane = compiled_scalar(_plane)
+_solve_load = compiled_scalar(_solve_load)
+_SOLVE = _compiled(_solve)
+
+
+@dataclass(frozen=True, slots=True)
+class CompiledKernel:
+    """A support kernel in the form the compiled inverse map reads (see the module docstring).
+
+    ``discrete`` marks point supports, whose facets are tested; ``work`` is the number of terms
+    (points or edges) summed per evaluation.
+    """
+
+    parts: tuple
+    discrete: bool
+    work: int
+
+    def solve(
+        self, loads: np.ndarray, units: np.ndarray, scale: float
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Safety factors ``(K,)`` and sliding twists ``(K, 3)`` [SI] of ``loads`` ``(K, 3)``
+        [N, N m] (``inf`` and NaN for a zero load); ``units`` = ``(max_force, max_force,
+        max_moment)`` normalise the coordinates and ``scale`` (``mu * N``) multiplies the kernel.
+
+        Raises :class:`ConvergenceError` where Newton stopped away from a minimum.
+        """
+        count = len(loads)
+        safety = np.empty(count)
+        twist = np.empty((count, 3))
+        gradient = np.empty(count)
+        loads = np.ascontiguousarray(loads, dtype=float)
+        _pick(_SOLVE, count, self.work)(
+            self.parts, self.discrete, loads, units, scale, safety, twist, gradient
+        )
+        worst = int(np.argmax(gradient)) if count > 1 else 0
+        if gradient[worst] > INVERSE_GRADIENT_RTOL:
+            raise not_converged(loads[worst], float(gradient[worst]))
+        return safety, twist
+
+
+def not_converged(load: np.ndarray, relative_gradient: float) -> ConvergenceError:
+    """The error of a load where Newton stopped away from a minimum."""
+    return ConvergenceError(
+        f"the inverse map did not converge for load {load.tolist()} (relative gradient "
+        f"{relative_gradient:.2g}). Pressure and friction functions must be smooth over the "
+        "patch: where mu or p jumps or has a kink (two materials, a step in pressure), describe "
+        "each smooth region as its own patch and sum them with LimitSurface.combine. Otherwise, "
+        "please report this load."
+    )
+
+
+def compile_kernel(kernel: SupportKernel) -> CompiledKernel | None:
+    """The compiled form of a point-set or polygon kernel, posed or not (``None`` for others,
+    which take the NumPy path)."""
+    transform, posed = np.eye(3), False
+    if isinstance(kernel, PosedKernel):
+        transform, posed, kernel = twist_to_local(kernel.pose), True, kernel.local
+    no_edges = np.empty((7, 0))
+    if isinstance(kernel, PointSetKernel) and kernel.smoothing == 0.0:
+        if posed and kernel.discrete:
+            return None  # facets are tested in the contact frame
+        parts = (POINTS, *_point_columns(kernel), no_edges, 0.0, transform, posed)
+        return CompiledKernel(parts=parts, discrete=kernel.discrete, work=len(kernel.weights))
+    if isinstance(kernel, EdgeSumKernel):
+        reach = FAR_FIELD_RADII * kernel.size
+        edges = np.array(kernel.edge_table, dtype=float)
+        parts = (EDGES, *_point_columns(kernel.far), edges, reach, transform, posed)
+        return CompiledKernel(parts=parts, discrete=False, work=kernel.edge_table.shape[1])
+    return None
+
+
+def _point_columns(kernel: PointSetKernel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Copies (writable, contiguous: every kernel then has the same numba types, compiled once)
+    of the points' x, y [m] and weights."""
+    points = np.asarray(kernel.points, dtype=float)
+    return (
+        np.array(points[:, 0], dtype=float),
+        np.array(points[:, 1], dtype=float),
+        np.array(kernel.weights, dtype=float),
+    )

@@ -1,0 +1,143 @@
+"""The compiled inverse map gives the answers of the NumPy path it replaces (damped Newton, facet
+tests and continuation in ``fixplan.surface.inverse``) for every kind of load: from twists,
+random directions and sizes, on and next to facets (both sides of a kink), near pure moments,
+far outside and deep inside; for point supports, polygons, posed polygons and tactile grids."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fixplan import ConvergenceError, pressure
+from fixplan.surface.compiled_inverse import compile_kernel, not_converged
+from fixplan.surface.disk_kernel import DiskKernel
+from fixplan.surface.inverse import solve
+from fixplan.surface.kernels import PosedKernel, SumKernel
+from fixplan.surface.limit_surface import LimitSurface
+from fixplan.surface.point_kernel import PointSetKernel
+
+SAFETY_RTOL = 1e-12  # both run Newton to 1e-12 on the twist: s agrees to about its square
+MOTION_RAD = 1e-9  # ... and the motions to about that angle
+
+rng0 = np.random.default_rng(11)
+CLOUD = rng0.uniform(-0.05, 0.05, size=(300, 2))
+
+SURFACES = {
+    "three points": lambda: LimitSurface(
+        pressure.points(0.05 * np.array([[0.0, 1.0], [-0.866, -0.5], [0.866, -0.5]])),
+        mu=0.5,
+        normal_force=30.0,
+    ),
+    "300 weighted points": lambda: LimitSurface(
+        pressure.points(CLOUD, rng0.uniform(0.2, 2.0, len(CLOUD))), mu=0.4, normal_force=80.0
+    ),
+    "shifted points": lambda: LimitSurface(
+        pressure.points([[0.0, 0.0], [0.04, 0.01], [0.01, 0.03]], [2.0, 1.0, 1.5]).shifted(
+            0.02, -0.01
+        ),
+        mu=0.7,
+        normal_force=5.0,
+    ),
+    "rectangle 10:1": lambda: LimitSurface(
+        pressure.rectangle(0.1, 0.01), mu=0.25, normal_force=200.0
+    ),
+    "rotated shifted rectangle": lambda: LimitSurface(
+        pressure.rectangle(0.05, 0.02).rotated(0.4).shifted(0.03, -0.01), mu=0.6, normal_force=8.0
+    ),
+    "tactile grid": lambda: LimitSurface(
+        pressure.grid(
+            [-0.006, -0.002, 0.002, 0.006],
+            [-0.004, 0.0, 0.004],
+            [[0.2, 1.0, 0.0, 0.1], [0.5, 3.0, 2.0, 1.0], [1.0, 0.0, 1.0, 2.5]],
+        ),
+        mu=0.8,
+        normal_force=6.0,
+    ),
+}
+
+
+def numpy_path(surface, loads):
+    """Safety factors and SI twists of nonzero ``loads`` by the NumPy path, normalised as
+    ``LimitSurface`` does."""
+    units = np.array([surface.max_force, surface.max_force, surface.max_moment])
+    size = np.max(np.abs(loads / units), axis=1)
+    result = solve(surface._kernel, surface._scale, loads / size[:, None], units)
+    return result.safety_factor / size, result.twist
+
+
+def distributions(surface, rng):
+    """name: loads ``(n, 3)`` of each distribution of the benchmark."""
+    rho = surface.characteristic_length
+    twists = rng.normal(size=(12, 3)) * [1.0, 1.0, 1.0 / rho]
+    directions = rng.normal(size=(12, 3)) * [1.0, 1.0, rho]
+    loads = {
+        "from twists": surface.load(twists),
+        "random directions and sizes": directions
+        * surface.max_force
+        * rng.uniform(0.01, 100.0, (12, 1)),
+        "near pure moment": surface.load([0.0, 0.0, 1.0]) + directions * 1e-7 * surface.max_force,
+        "far outside": surface.load(twists) * 1e6,
+        "deep inside": surface.load(twists) * 1e-6,
+    }
+    points = surface._kernel.facets[0]
+    if len(points):
+        k = rng.integers(0, len(points), 12)
+        offsets = rng.normal(size=(12, 2)) * 1e-7 * rho
+        near = surface.load_at_cor(points[k] + offsets) * rng.uniform(0.5, 1.5, (12, 1))
+        on = surface.load_at_cor(points[k]) * rng.uniform(0.5, 1.5, (12, 1))
+        loads["next to facets"] = np.concatenate([near, -near])
+        loads["on facets"] = on
+    return loads
+
+
+CASES = [(name, kind) for name in SURFACES for kind in ("single", "batch")]
+
+
+@pytest.mark.parametrize(("name", "how"), CASES)
+def test_the_compiled_path_gives_the_answers_of_the_numpy_path(name, how):
+    surface = SURFACES[name]()
+    assert surface._compiled is not None
+    rng = np.random.default_rng(5)
+    rho = surface.characteristic_length
+    for distribution, loads in distributions(surface, rng).items():
+        expected_safety, expected_twists = numpy_path(surface, loads)
+        if how == "single":
+            pairs = [surface.motion_and_safety_factor(load) for load in loads]
+            motions = np.array([m for m, _ in pairs])
+            safety = np.array([s for _, s in pairs])
+        else:
+            motions, safety = surface.motion_and_safety_factor(loads)
+        np.testing.assert_allclose(safety, expected_safety, rtol=SAFETY_RTOL, err_msg=distribution)
+        a = motions * [1.0, 1.0, rho]
+        b = expected_twists * [1.0, 1.0, rho]
+        b /= np.linalg.norm(b, axis=1, keepdims=True)
+        angle = np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.einsum("ij,ij->i", a, b))
+        assert np.max(angle) <= MOTION_RAD, distribution
+
+
+def test_zero_loads_in_a_batch_are_held_with_no_motion():
+    surface = SURFACES["three points"]()
+    loads = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    motions, safety = surface.motion_and_safety_factor(loads)
+    assert safety[0] == math.inf and safety[2] == math.inf
+    assert np.all(np.isnan(motions[[0, 2]]))
+    assert np.all(np.isfinite(motions[1])) and math.isfinite(safety[1])
+
+
+def test_kernels_without_a_compiled_form_keep_the_numpy_path():
+    points = PointSetKernel(np.array([[0.0, 0.0], [0.01, 0.0]]), np.array([0.5, 0.5]), True)
+    disk = DiskKernel(0.01, "uniform")
+    pose = pressure.disk(0.01).shifted(0.01, 0.0).pose
+    assert compile_kernel(disk) is None
+    assert compile_kernel(SumKernel((disk, points), (1.0, 1.0))) is None
+    assert compile_kernel(PosedKernel(points, pose)) is None  # facets live in the contact frame
+    assert compile_kernel(points.smoothed(1e-3)) is None
+    assert compile_kernel(points) is not None
+
+
+def test_the_convergence_error_names_the_load_and_what_to_do():
+    error = not_converged(np.array([1.0, 2.0, 3.0]), 0.01)
+    assert isinstance(error, ConvergenceError)
+    assert "[1.0, 2.0, 3.0]" in str(error) and "LimitSurface.combine" in str(error)
