@@ -109,6 +109,27 @@ def twist_about(cor, ccw: bool = True) -> np.ndarray:
     return sign * np.array([cy, -cx, 1.0])
 
 
+def rotation(cor, spin: float) -> np.ndarray:
+    """Twist rotating about ``cor`` at rate ``spin`` [rad/s] (counter-clockwise if positive)."""
+    return spin * twist_about(cor)
+
+
+def central_differences(kernel, twist, step: float) -> np.ndarray:
+    """Hessian ``(3, 3)`` of a support kernel at ``twist`` by central differences of its exact
+    gradient, with steps ``step`` relative to the twist's size (the spin scaled by the kernel's
+    size)."""
+    size = kernel.size
+    scale = np.hypot(np.hypot(twist[0], twist[1]), size * twist[2])
+    columns = []
+    for j in range(3):
+        offset = np.zeros(3)
+        offset[j] = step * scale / (size if j == 2 else 1.0)
+        plus = kernel.evaluate((twist + offset)[None, :])[1][0]
+        minus = kernel.evaluate((twist - offset)[None, :])[1][0]
+        columns.append((plus - minus) / (2.0 * offset[j]))
+    return np.column_stack(columns)
+
+
 def cor_of(twist) -> np.ndarray | None:
     """Centre of rotation of ``twist``, or ``None`` for a pure translation."""
     vx, vy, w = (float(v) for v in twist)

@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import SURFACES as SHARED_SURFACES
 
 from fixplan import ConvergenceError, pressure
 from fixplan.surface.compiled_inverse import compile_kernel, not_converged
@@ -24,12 +25,11 @@ MOTION_RAD = 1e-9  # ... and the motions to about that angle
 rng0 = np.random.default_rng(11)
 CLOUD = rng0.uniform(-0.05, 0.05, size=(300, 2))
 
+#: The shared surfaces the compiled path covers (points, polygons, grids), and two more cases.
 SURFACES = {
-    "three points": lambda: LimitSurface(
-        pressure.points(0.05 * np.array([[0.0, 1.0], [-0.866, -0.5], [0.866, -0.5]])),
-        mu=0.5,
-        normal_force=30.0,
-    ),
+    name: SHARED_SURFACES[name]
+    for name in ("three points", "rectangle 10:1", "rotated shifted rectangle", "tactile grid")
+} | {
     "300 weighted points": lambda: LimitSurface(
         pressure.points(CLOUD, rng0.uniform(0.2, 2.0, len(CLOUD))), mu=0.4, normal_force=80.0
     ),
@@ -39,21 +39,6 @@ SURFACES = {
         ),
         mu=0.7,
         normal_force=5.0,
-    ),
-    "rectangle 10:1": lambda: LimitSurface(
-        pressure.rectangle(0.1, 0.01), mu=0.25, normal_force=200.0
-    ),
-    "rotated shifted rectangle": lambda: LimitSurface(
-        pressure.rectangle(0.05, 0.02).rotated(0.4).shifted(0.03, -0.01), mu=0.6, normal_force=8.0
-    ),
-    "tactile grid": lambda: LimitSurface(
-        pressure.grid(
-            [-0.006, -0.002, 0.002, 0.006],
-            [-0.004, 0.0, 0.004],
-            [[0.2, 1.0, 0.0, 0.1], [0.5, 3.0, 2.0, 1.0], [1.0, 0.0, 1.0, 2.5]],
-        ),
-        mu=0.8,
-        normal_force=6.0,
     ),
 }
 

@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 import pytest
+from reference import central_differences, rotation
 
 from fixplan.surface.disk_kernel import AnnulusKernel, DiskKernel
 from fixplan.surface.kernels import SupportKernel
@@ -76,10 +77,6 @@ def polar_hessian(profile, c):
     return np.einsum("n,ni,nj->ij", dtheta * length, g, g)
 
 
-def rotation(c, spin):
-    return spin * np.array([c[1], -c[0], 1.0])
-
-
 #: Centres of rotation in units of the radius: centre, inside, near the rim, outside, far.
 CENTRES = [(0.0, 0.0), (0.2, -0.1), (0.45, 0.6), (0.0, 0.97), (1.03, 0.0), (-1.5, 1.1), (6.0, 8.0)]
 
@@ -95,20 +92,6 @@ def test_the_disk_hessian_is_the_polar_quadrature_of_the_integral(profile, centr
         hessian = kernel.hessian(rotation(c, spin)[None, :])[0]
         np.testing.assert_allclose(hessian, reference / abs(spin), rtol=0.0,
                                    atol=QUADRATURE_RTOL * scale / abs(spin))  # fmt: skip
-
-
-def central_differences(kernel, twist):
-    """Hessian ``(3, 3)`` by central differences of the kernel's exact gradient."""
-    size = kernel.size
-    scale = np.hypot(np.hypot(twist[0], twist[1]), size * twist[2])
-    columns = []
-    for j in range(3):
-        step = np.zeros(3)
-        step[j] = STEP * scale / (size if j == 2 else 1.0)
-        plus = kernel.evaluate((twist + step)[None, :])[1][0]
-        minus = kernel.evaluate((twist - step)[None, :])[1][0]
-        columns.append((plus - minus) / (2.0 * step[j]))
-    return np.column_stack(columns)
 
 
 KERNELS = {
@@ -143,7 +126,7 @@ def test_the_disk_hessian_is_the_derivative_of_the_exact_gradient(name):
     np.testing.assert_array_equal(h, reference_h)
     np.testing.assert_array_equal(gradient, reference_gradient)
     for twist, analytic in zip(twists, hessian, strict=True):
-        reference = central_differences(kernel, twist)
+        reference = central_differences(kernel, twist, STEP)
         scale = np.max(np.abs(reference))
         np.testing.assert_allclose(analytic, reference, rtol=0.0, atol=DIFFERENCE_RTOL * scale)
         np.testing.assert_array_equal(analytic, analytic.T)

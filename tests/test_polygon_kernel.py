@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from polygon_cells import edge_sum_kernel
+from reference import central_differences, rotation
 
 from fixplan.surface.geometry import signed_area
 from fixplan.surface.polygon_kernel import polygon_edges
@@ -113,10 +114,6 @@ def polar_hessian(cells, c):
     return np.einsum("n,ni,nj->ij", dtheta * length, g, g)
 
 
-def rotation(c, spin):
-    return spin * np.array([c[1], -c[0], 1.0])
-
-
 CASES = [(shape, where) for shape in SHAPES for where in centres(SHAPES[shape])]
 
 
@@ -131,20 +128,6 @@ def test_the_hessian_is_the_polar_quadrature_of_the_integral(shape, where):
         hessian = kernel.hessian(rotation(c, spin)[None, :])[0]
         np.testing.assert_allclose(hessian, reference / abs(spin), rtol=0.0,
                                    atol=QUADRATURE_RTOL * scale / abs(spin))  # fmt: skip
-
-
-def central_differences(kernel, twist):
-    """Hessian ``(3, 3)`` by central differences of the kernel's exact gradient."""
-    size = kernel.size
-    scale = np.hypot(np.hypot(twist[0], twist[1]), size * twist[2])
-    columns = []
-    for j in range(3):
-        step = np.zeros(3)
-        step[j] = STEP * scale / (size if j == 2 else 1.0)
-        plus = kernel.evaluate((twist + step)[None, :])[1][0]
-        minus = kernel.evaluate((twist - step)[None, :])[1][0]
-        columns.append((plus - minus) / (2.0 * step[j]))
-    return np.column_stack(columns)
 
 
 SMOOTH_CENTRES = ("inside", "outside", "far")
@@ -166,7 +149,7 @@ def test_the_hessian_is_the_derivative_of_the_exact_gradient(shape):
     np.testing.assert_allclose(h, reference_h, rtol=1e-14)
     np.testing.assert_allclose(gradient, reference_gradient, rtol=1e-14, atol=1e-14 * h.max())
     for twist, analytic in zip(twists, hessian, strict=True):
-        reference = central_differences(kernel, twist)
+        reference = central_differences(kernel, twist, STEP)
         scale = np.max(np.abs(reference))
         np.testing.assert_allclose(analytic, reference, rtol=0.0, atol=DIFFERENCE_RTOL * scale)
         # h is homogeneous of degree one: the Hessian annuls the twist.

@@ -31,6 +31,7 @@ from fixplan.surface.compiled_inverse import (
     SMOOTHING_STAGES,
     not_converged,
 )
+from fixplan.surface.compiled_inverse import _newton_step as _newton_step_one
 from fixplan.surface.kernels import SupportKernel
 from fixplan.surface.point_kernel import slowest_points
 from fixplan.tolerances import (
@@ -174,7 +175,7 @@ def _solve_one(kernel: SupportKernel, load: np.ndarray, units: np.ndarray):
     h, g, hess = _terms_one(kernel, twist)
     stalled = True
     for _ in range(INVERSE_MAX_ITERATIONS):
-        (s1, s2), decrement = _newton_step_one(*_projected(g, hess, b1, b2))
+        s1, s2, decrement = _newton_step_one(*_projected(g, hess, b1, b2))
         if decrement <= INVERSE_RTOL**2 * h:
             stalled = False
             break
@@ -230,22 +231,6 @@ def _plane_basis_one(direction: list[float]) -> tuple[list[float], list[float]]:
     norm = math.sqrt(sum(x * x for x in e1))
     ax, ay, az = (x / norm for x in e1)
     return [ax, ay, az], [dy * az - dz * ay, dz * ax - dx * az, dx * ay - dy * ax]
-
-
-def _newton_step_one(g1, g2, h11, h12, h22) -> tuple[tuple[float, float], float]:
-    """:func:`_newton_step` of one point from its projected gradient and Hessian: the step in
-    plane coordinates and the decrement."""
-    ridge = RIDGE * abs(h11 + h22) + 1e-300
-    h11, h22 = h11 + ridge, h22 + ridge
-    det = h11 * h22 - h12 * h12
-    if det > 0.0:
-        s1 = -(h22 * g1 - h12 * g2) / det
-        s2 = -(h11 * g2 - h12 * g1) / det
-        decrement = -(g1 * s1 + g2 * s2)
-        if math.isfinite(decrement) and decrement >= 0.0:
-            return (s1, s2), decrement
-    # Steepest descent where the Hessian is unusable (never at a smooth minimum).
-    return (-g1, -g2), g1 * g1 + g2 * g2
 
 
 def _check_converged(z, e1, e2, loads, terms) -> None:
