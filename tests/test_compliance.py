@@ -324,32 +324,26 @@ def _random_fixture(rng):
     return problem, stiffness
 
 
-@pytest.mark.parametrize(
-    "seed",
-    [
-        pytest.param(
-            0,
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason="known limitation: the friction bounds' fixed point does not converge "
-                "along a stretch of this fixture's path; the collapse is not bracketed within "
-                "the budget of increments (NaN)",
-            ),
-        ),
-        1,
-        2,
-        3,
-        4,  # seated
-        10,  # seated
-    ],
-)
-def test_over_random_fixtures_first_slip_and_collapse_never_exceed_the_rigid_safety_factor(seed):
+def _random_case(seed):
     from fixplan.planner.planner import Planner
 
     problem, stiffness = _random_fixture(np.random.default_rng(seed))
     result = analyse(problem, None, stiffness=stiffness)
     rigid = Planner(problem, allow_squeeze=True).solve().safety_factors["cut"]
-    first, collapse = result.first_slip["cut"], result.collapse["cut"]
+    return result.first_slip["cut"], result.collapse["cut"], rigid
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3, 4, 10])  # 4 and 10 are seated
+def test_over_random_fixtures_the_first_slip_never_exceeds_the_rigid_safety_factor(seed):
+    first, _, rigid = _random_case(seed)
+    assert first <= rigid * (1 + 1e-9)
+
+
+# Seed 0 is left out here: its ramp stalls and its collapse is reported as not found (NaN), the
+# known limit of fixplan.motion.load_ramp (9 of the first 50 seeds).
+@pytest.mark.parametrize("seed", [1, 2, 3, 4, 10])
+def test_over_random_fixtures_the_collapse_lies_between_first_slip_and_rigid_safety_factor(seed):
+    first, collapse, rigid = _random_case(seed)
     assert first <= collapse * (1 + 1e-9)
     assert collapse <= rigid * (1 + 1e-6)
 
