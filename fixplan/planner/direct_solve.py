@@ -67,7 +67,7 @@ class DirectSolver:
         vector = program.parameter_vector()
         q, _ = program.cost(vector)
         a, b = program.constraints(vector)
-        solver = clarabel.DefaultSolver(program.quadratic, q, a, b, cones, options)
+        solver = clarabel.DefaultSolver(program.quadratic, q, program.matrix(a), b, cones, options)
         # The offsets of the variables in Clarabel's x: those of the matrix stuffing, the last
         # reduction that sees variables (canonicalisation may add auxiliary ones before them).
         offsets = [d.var_offsets for d in inverse if hasattr(d, "var_offsets")][-1]
@@ -87,8 +87,8 @@ class DirectSolver:
         q, constant = self._program.cost(vector)
         a, b = self._program.constraints(vector)
         update = {"q": q, "b": b}
-        if a is not None:
-            update["A"] = a.data  # the same pattern, so only the values change
+        if not self._program.fixed_a:
+            update["A"] = a  # the same pattern, so only the values change
         self._solver.update(**update)
         solution = self._solver.solve()
         self.status = str(solution.status)
@@ -144,9 +144,7 @@ class _Program:
     (``P`` constant; the patterns of ``A`` and ``b`` fixed)."""
 
     def __init__(self, program, parameters):
-        self._columns = [
-            (p, program.param_id_to_col[p.id], p.size) for p in parameters
-        ]  # fmt: skip
+        self._columns = [(p, program.param_id_to_col[p.id], p.size) for p in parameters]
         self._size = program.total_param_size + 1  # the last entry is the constant 1
         self._variables = program.x.size
         self._q = sp.csr_array(program.q)
@@ -157,7 +155,8 @@ class _Program:
         self._split = int(indptr[-2])  # entries of A; the rest are b's, in the last column
         self._a_shape = (int(shape[0]), int(shape[1]) - 1)
         self._a_indptr = np.asarray(indptr[:-1])
-        self._a_fixed = self._a_map[:, : self._size - 1][: self._split].nnz == 0
+        #: Whether ``A`` does not depend on the parameters (only ``b`` and ``q`` change).
+        self.fixed_a = self._a_map[:, : self._size - 1][: self._split].nnz == 0
         if program.reduced_P is None or program.reduced_P.matrix_data is None:
             self.quadratic = sp.csc_matrix((self._variables, self._variables))
             self.parametric_p = False
@@ -169,7 +168,6 @@ class _Program:
             values = p_map @ np.r_[np.zeros(self._size - 1), 1.0]
             full = sp.csc_matrix((values, p_indices, p_indptr), shape=p_shape)
             self.quadratic = sp.csc_matrix(sp.triu(full))
-        self._a_built = False
 
     def parameter_vector(self) -> np.ndarray:
         vector = np.zeros(self._size)
@@ -183,21 +181,18 @@ class _Program:
         full = self._q @ vector
         return full[: self._variables], float(full[self._variables])
 
-    def constraints(self, vector) -> tuple[sp.csc_matrix | None, np.ndarray]:
-        """Clarabel's ``A`` (``None`` after the first call when it does not depend on the
-        parameters) and ``b``: cvxpy's ``A x + b`` in the cones is ``b_C - A_C x`` with
-        ``A_C = -A``, ``b_C = b``."""
+    def constraints(self, vector) -> tuple[np.ndarray, np.ndarray]:
+        """Clarabel's ``A`` as its values in the fixed pattern (:meth:`matrix`) and ``b``:
+        cvxpy's ``A x + b`` in the cones is ``b_C - A_C x`` with ``A_C = -A``, ``b_C = b``."""
         values = self._a_map @ vector
         b = np.zeros(self._a_shape[0])
         b[self._a_rows[self._split :]] = values[self._split :]
-        if self._a_built and self._a_fixed:
-            return None, b
-        self._a_built = True
-        a = sp.csc_matrix(
-            (-values[: self._split], self._a_rows[: self._split], self._a_indptr),
-            shape=self._a_shape,
-        )
-        return a, b
+        return -values[: self._split], b
+
+    def matrix(self, values) -> sp.csc_matrix:
+        """Clarabel's ``A`` from its ``values``."""
+        pattern = (self._a_rows[: self._split], self._a_indptr)
+        return sp.csc_matrix((values, *pattern), shape=self._a_shape)
 
 
 def _equality_rows(constraints) -> dict:
