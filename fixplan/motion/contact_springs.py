@@ -37,6 +37,7 @@ import numpy as np
 
 from fixplan.errors import ConvergenceError, InvalidArgumentError
 from fixplan.planner.direct_solve import INFEASIBLE, DirectSolver
+from fixplan.planner.stacking import assign
 
 #: A polished solution is accepted when its equilibrium residual, negative normal forces and
 #: closed gaps of lifted contacts are below this fraction of the step's force scale.
@@ -145,9 +146,9 @@ class ContactQP:
         Solved by Clarabel directly on the compiled data once cvxpy has solved the QP once
         (:class:`~fixplan.planner.direct_solve.DirectSolver`); through cvxpy where that path
         does not give an answer."""
-        self.reference.value = np.asarray(reference, float).ravel() / self.units
-        self.wrench.value = np.asarray(wrench, float) / self.rows
-        self.bound.value = np.asarray(bound, float) / self.scale
+        assign(self.reference, np.ravel(reference) / self.units)
+        assign(self.wrench, np.asarray(wrench, float) / self.rows)
+        assign(self.bound, np.maximum(bound, 0.0) / self.scale)
         if self._direct is not None:
             values = self._direct.solve(accept_inaccurate=True)
             if self._direct.status in INFEASIBLE:
