@@ -31,11 +31,10 @@ Where normal forces do not depend on the slips (a part pressed on its supports b
 clamps, loads in the support plane) the path does not matter and the collapse multiple is the
 rigid limit load; in general it depends on the path (friction is not associated with the normal
 direction). On ``problems/fixture-321-compliant.toml``, dividing :data:`MAX_FORCE_CHANGE` by 4
-changes the collapse of the eight cases bracketed both ways by at most 1.6e-4 relative (a ninth,
-``profile-end-conventional``, then runs out of its budget). Where the friction bounds'
-fixed point does not converge along a stretch of the path (seen in 9 of 50 random fixtures of the
-tests, the body creeping over hundreds of small increments), the budget of increments ends the
-ramp and the collapse is reported as not found (NaN).
+changes the collapse of its nine cases with a finite one by at most 1.6e-4 relative. Where the
+friction bounds' fixed point does not converge along a stretch of the path (seen in 6 of 50
+random fixtures of the tests, the body creeping over hundreds of small increments), the budget of
+increments ends the ramp and the collapse is reported as not found (NaN).
 """
 
 from __future__ import annotations
