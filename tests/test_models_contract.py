@@ -142,6 +142,25 @@ def test_single_loads_give_scalars_and_batches_give_arrays(name, field):
 
 
 @pytest.mark.parametrize(("name", "field"), CASES)
+def test_gauge_terms_give_the_safety_factor_of_every_load(name, field):
+    """The stacked form the planner checks loads with (norms and maxima of linear maps of the
+    load) is the model's own gauge, to 1e-12; only models whose gauge has no such form opt out."""
+    m = model(name, field)
+    terms = m.gauge_terms()
+    if terms is None:
+        assert isinstance(m, (Exact, FacetedEllipsoid))
+        return
+    loads = loads_for(m, 200)[:, : m.load_dimension]
+    gauge = np.zeros(len(loads))
+    for kind, matrix in terms:
+        values = loads @ matrix.T
+        gauge += np.linalg.norm(values, axis=1) if kind == "norm" else values.max(axis=1)
+    expected = 1.0 / m.safety_factor(loads, normal_force=1.0)
+    np.testing.assert_allclose(gauge, expected, rtol=1e-12)
+    assert model(name, field, mu=0.0).gauge_terms() is None  # frictionless: asked directly
+
+
+@pytest.mark.parametrize(("name", "field"), CASES)
 def test_model_is_centrally_symmetric(name, field):
     m = model(name, field)
     loads = loads_for(m, 64, seed=1)

@@ -235,7 +235,9 @@ def test_verification_flags_a_wrench_outside_its_friction_set():
     friction = np.array([[0.0], [5.0], [0.0], [6.0]])  # 6 N > mu * 10 N on the second finger
     wrenches = np.column_stack([off_axis_load(offset=0.0).wrench])
     answer = {"normal": normal, "friction": friction, "scale": np.ones(1)}
-    _, problems = verify(planner.problem, planner.layout, planner.models, answer, wrenches, 0.02)
+    _, problems = verify(
+        planner.problem, planner.layout, planner.friction_use, answer, wrenches, 0.02
+    )
     assert any("'right' exceeds its friction set" in p for p in problems)
 
 
@@ -245,7 +247,9 @@ def test_verification_flags_a_pulling_contact_and_friction_without_normal_force(
     friction = np.array([[0.0], [0.0], [2.0], [0.0]])  # yet carries 2 N
     wrenches = np.column_stack([off_axis_load(offset=0.0).wrench])
     answer = {"normal": normal, "friction": friction, "scale": np.ones(1)}
-    _, problems = verify(planner.problem, planner.layout, planner.models, answer, wrenches, 0.02)
+    _, problems = verify(
+        planner.problem, planner.layout, planner.friction_use, answer, wrenches, 0.02
+    )
     assert any("'left' pulls: normal force -1 N" in p for p in problems)
     assert any("'right' carries friction without normal force" in p for p in problems)
 

@@ -91,6 +91,26 @@ class FrictionModel(ConvexForm, ABC):
             "FacetedEllipsoid or Exact to predict motion"
         )
 
+    def _gauge_terms(self) -> tuple[tuple[str, np.ndarray], ...] | None:
+        """The gauge as a sum of terms linear in ``q`` (see :meth:`gauge_terms`), or ``None``."""
+        return None
+
+    def gauge_terms(self) -> tuple[tuple[str, np.ndarray], ...] | None:
+        """The gauge at unit normal force as a sum of terms linear in the load, or ``None``.
+
+        A term ``("norm", G)`` contributes ``‖G L‖₂``, a term ``("max", G)`` contributes
+        ``max(G L)``, for loads ``L`` in the coordinates of :meth:`constraints` (about the frame
+        origin). The safety factor of ``L`` at normal force ``N`` is ``N`` over the sum; with
+        these terms many contacts' loads are checked in a few matrix products
+        (:mod:`fixplan.planner.verify`). ``None`` for a frictionless model and for models whose
+        gauge has no such form.
+        """
+        terms = None if self.frictionless else self._gauge_terms()
+        if terms is None:
+            return None
+        to_q = self._normalising_map()
+        return tuple((kind, np.asarray(matrix, dtype=float) @ to_q) for kind, matrix in terms)
+
     # -- description -------------------------------------------------------------------------
 
     @property

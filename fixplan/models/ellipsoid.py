@@ -221,6 +221,9 @@ class Ellipsoid(FrictionModel):
         fy = q[:, 1] - t[1] * q[:, 2]
         return np.sqrt(fx * fx + fy * fy + q[:, 2] * q[:, 2])
 
+    def _gauge_terms(self):
+        return (("norm", _shear(self.tilt)),)
+
     def _normal(self, q):
         return q @ self.matrix
 
@@ -363,6 +366,9 @@ class FittedEllipsoid(FrictionModel):
             + 2.0 * (m[0, 1] * x * y + m[0, 2] * x * z + m[1, 2] * y * z)
         )
         return np.sqrt(np.maximum(form, 0.0))
+
+    def _gauge_terms(self):
+        return (("norm", np.linalg.cholesky(self.matrix).T),)
 
     def _normal(self, q):
         return q @ self.matrix

@@ -108,6 +108,9 @@ class Cone(FrictionModel):
         fy = q[:, 1] - t[1] * q[:, 2]
         return np.sqrt(fx * fx + fy * fy) + np.abs(q[:, 2])
 
+    def _gauge_terms(self):
+        return (("norm", _shear(self.tilt)[:2]), ("norm", np.array([[0.0, 0.0, 1.0]])))
+
     def _unit_conic(self):
         # ||F q|| + |q_m| <= N  as  ||F q|| <= N - q_m  and  ||F q|| <= N + q_m.
         force = _shear(self.tilt)[:2]
@@ -258,6 +261,9 @@ class Pyramid(FrictionModel):
         apothem = _apothem(self.facets, self.inscribed)
         return _polygon_gauge(fx, fy, self.facets, apothem) + np.abs(q[:, 2])
 
+    def _gauge_terms(self):
+        return (("max", self._rows),)
+
     def _unit_conic(self):
         return _linear_conic(self._rows)
 
@@ -319,6 +325,9 @@ class PointCone(FrictionModel):
 
     def _gauge(self, q):
         return np.hypot(q[:, 0], q[:, 1])
+
+    def _gauge_terms(self):
+        return (("norm", np.eye(2)),)
 
     def _normal(self, q):
         return q
@@ -393,6 +402,9 @@ class PointPyramid(FrictionModel):
     def _gauge(self, q):
         apothem = _apothem(self.facets, self.inscribed)
         return _polygon_gauge(q[:, 0], q[:, 1], self.facets, apothem)
+
+    def _gauge_terms(self):
+        return (("max", self._rows),)
 
     def _unit_conic(self):
         return _linear_conic(self._rows)

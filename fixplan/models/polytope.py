@@ -253,6 +253,9 @@ class Polytope(FrictionModel):
     def _gauge(self, q):
         return np.max(np.abs(q @ self.rows.T), axis=1)
 
+    def _gauge_terms(self):
+        return (("max", np.vstack([self.rows, -self.rows])),)
+
     def _normal(self, q):
         return self._facets[np.argmax(q @ self._facets.T, axis=1)]
 

@@ -19,18 +19,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from fixplan.models.base import FrictionModel
+from fixplan.planner.friction_use import FrictionUse
 from fixplan.planner.problem import Problem
 from fixplan.planner.screw import Screw
 from fixplan.planner.stacking import ContactLayout
-from fixplan.planner.verify import friction_use
 from fixplan.tolerances import FRICTION_SET_RTOL, HELD_RTOL, MAX_SAFETY_FACTOR, MULTIPLE_ATOL
 
 
 def analyse_cases(
     problem: Problem,
     layout: ContactLayout,
-    models: list[FrictionModel],
+    friction_use: FrictionUse,
     highest: dict,
     lowest: dict | None,
     wrenches: np.ndarray,
@@ -58,11 +57,8 @@ def analyse_cases(
             continue
         twist = twist if wrenches[:, j] @ twist >= 0.0 else -twist
         motions[name] = Screw.from_twist(twist, length_scale)
-    utilisation = np.zeros(normal.shape)
     noise = FRICTION_SET_RTOL * max(float(np.abs(normal).max()), 1e-12)
-    for i, model in enumerate(models):
-        load = friction[layout.slices[i]].T
-        utilisation[i] = np.minimum(friction_use(model, load, normal[i], noise=noise), 1.0)
+    utilisation = np.minimum(friction_use(friction, normal, noise=noise), 1.0)
     # Cases tied with the smallest margin (within solver accuracy): the first.
     critical = int(np.flatnonzero(margin <= margin.min() * (1.0 + HELD_RTOL))[0])
     return {

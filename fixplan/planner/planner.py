@@ -30,6 +30,7 @@ from fixplan.errors import InvalidArgumentError
 from fixplan.planner.analysis import analyse_cases
 from fixplan.planner.certificate import certificate
 from fixplan.planner.contact_models import contact_model
+from fixplan.planner.friction_use import FrictionUse
 from fixplan.planner.objectives import objective_value
 from fixplan.planner.plan import Plan
 from fixplan.planner.problem import (
@@ -71,6 +72,7 @@ class Planner:
         self.solver = solver
         self.models = [contact_model(c) for c in problem.contacts]
         self.layout = ContactLayout.of(problem, self.models)
+        self.friction_use = FrictionUse(self.models, self.layout.slices)
         positions = np.array([c.position for c in problem.contacts])
         spread = np.linalg.norm(positions - problem.body.center_of_mass, axis=1)
         self.length_scale = float(max(spread.max(), 1e-3))
@@ -125,14 +127,19 @@ class Planner:
             notes += self._squeeze_notes(squeezed)
             return self._plan(status, None, result["solver"], start, notes, fields)
         residual, problems = verify(
-            self.problem, self.layout, self.models, result, wrenches, self.length_scale
+            self.problem, self.layout, self.friction_use, result, wrenches, self.length_scale
         )
         if problems and result["solver"].startswith("CLARABEL"):
             retry = self._squeeze_free(objective, wrenches, given, squeezed, accurate=True)
             if retry["status"] == "optimal":
                 result = self._refine(objective, retry, wrenches, given, squeezed)
                 residual, problems = verify(
-                    self.problem, self.layout, self.models, result, wrenches, self.length_scale
+                    self.problem,
+                    self.layout,
+                    self.friction_use,
+                    result,
+                    wrenches,
+                    self.length_scale,
                 )
         if problems:
             status = "inaccurate"
@@ -220,7 +227,7 @@ class Planner:
             lowest = None
         decided = self._passive.copy()
         return analyse_cases(
-            self.problem, self.layout, self.models, highest, lowest, wrenches, decided,
+            self.problem, self.layout, self.friction_use, highest, lowest, wrenches, decided,
             self.length_scale,
         )  # fmt: skip
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fixplan.models.base import FrictionModel
+from fixplan.planner.friction_use import FrictionUse
 from fixplan.planner.problem import Problem
 from fixplan.planner.stacking import ContactLayout
 from fixplan.tolerances import EQUILIBRIUM_RTOL, FRICTION_SET_RTOL
@@ -13,7 +13,7 @@ from fixplan.tolerances import EQUILIBRIUM_RTOL, FRICTION_SET_RTOL
 def verify(
     problem: Problem,
     layout: ContactLayout,
-    models: list[FrictionModel],
+    friction_use: FrictionUse,
     answer: dict,
     wrenches: np.ndarray,
     length_scale: float,
@@ -55,53 +55,25 @@ def verify(
             )
     scale_force = max(float(np.abs(normal).max()), 1e-12)
     noise = FRICTION_SET_RTOL * scale_force
-    pressed = normal > noise
-    starts = [part.start for part in layout.slices]
-    # Largest friction component of each contact and case (a contact without friction: 0).
-    widths = np.array([part.stop - part.start for part in layout.slices])
-    loose = np.zeros_like(normal)
-    if friction.size:
-        sizes = np.abs(friction)
-        carried = np.maximum.reduceat(sizes, np.minimum(starts, len(sizes) - 1), axis=0)
-        loose = np.where(widths[:, None] > 0, carried, 0.0) > noise
     for i in np.flatnonzero((normal < -noise).any(axis=1)):
         name = problem.contacts[i].name
         problems.append(f"contact {name!r} pulls: normal force {normal[i].min():.3g} N")
-    for i in np.flatnonzero((loose & ~pressed).any(axis=1)):
+    use = friction_use(friction, normal, noise=noise)
+    pressed = normal > noise
+    for i in np.flatnonzero((np.isinf(use) & ~pressed).any(axis=1)):
         problems.append(
             f"contact {problem.contacts[i].name!r} carries friction without normal force"
         )
-    for i in np.flatnonzero((loose & pressed).any(axis=1)):
-        contact, model, fn = problem.contacts[i], models[i], normal[i]
-        load = friction[layout.slices[i]].T
-        # The excess of a contact's friction over its set, as a force, against the largest
-        # normal force: solver accuracy is absolute, so a lightly pressed contact may exceed its
-        # own set by more than FRICTION_SET_RTOL in relative terms and still be exact enough.
-        excess = (friction_use(model, load, fn, noise=noise) - 1.0) * np.maximum(fn, noise)
-        if np.any(pressed[i] & (excess > noise)):
-            worst = int(np.argmax(np.where(pressed[i], excess, -np.inf)))
-            problems.append(
-                f"contact {contact.name!r} exceeds its friction set by {excess[worst]:.3g} N "
-                f"(over {FRICTION_SET_RTOL:g} of the largest normal force, {scale_force:.3g} N)"
-            )
+    # The excess of a contact's friction over its set, as a force, against the largest normal
+    # force: solver accuracy is absolute, so a lightly pressed contact may exceed its own set by
+    # more than FRICTION_SET_RTOL in relative terms and still be exact enough.
+    excess = np.full(normal.shape, -np.inf)
+    excess[pressed] = (use[pressed] - 1.0) * normal[pressed]
+    for i in np.flatnonzero((excess > noise).any(axis=1)):
+        worst = int(np.argmax(excess[i]))
+        problems.append(
+            f"contact {problem.contacts[i].name!r} exceeds its friction set by "
+            f"{excess[i, worst]:.3g} N (over {FRICTION_SET_RTOL:g} of the largest normal force, "
+            f"{scale_force:.3g} N)"
+        )
     return relative, problems
-
-
-def friction_use(
-    model: FrictionModel, load: np.ndarray, normal_force: np.ndarray, *, noise: float
-) -> np.ndarray:
-    """Fraction of its friction set that each load ``(K, d)`` uses at ``normal_force`` ``(K,)``.
-
-    1 on the limit; 0 for loads and normal forces within ``noise`` [N] of 0 (solver noise);
-    ``inf`` for a load on a contact without normal force or without friction.
-    """
-    use = np.zeros(len(load))
-    carries = np.abs(load).max(axis=1) > noise
-    pressed = carries & (normal_force > noise)
-    use[carries & ~pressed] = np.inf
-    if np.any(pressed):
-        per_unit = load[pressed] / normal_force[pressed, None]  # the model at unit normal force
-        safety = np.atleast_1d(model.safety_factor(per_unit, normal_force=1.0))
-        with np.errstate(divide="ignore"):
-            use[pressed] = 1.0 / safety
-    return use

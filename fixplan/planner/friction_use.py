@@ -1,0 +1,104 @@
+"""How much of its friction set each contact load uses, for all contacts and cases at once.
+
+Verification and the safety analysis ask this of every (contact, load case) after each solve. A
+model whose gauge is a sum of norms and maxima of linear maps of the load
+(:meth:`~fixplan.models.FrictionModel.gauge_terms`: ellipsoids, cones, pyramids, polytopes) is
+checked for all its cases in a few stacked sparse products; the others (exact, SDP and faceted
+models, frictionless contacts) are asked one by one through their ``safety_factor``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from fixplan.models.base import FrictionModel
+
+
+class FrictionUse:
+    """The fraction of its friction set that each contact's friction load uses.
+
+    Parameters
+    ----------
+    models : sequence of FrictionModel
+        The friction model of each contact.
+    slices : sequence of slice
+        Rows of each contact's friction load in the stacked friction loads ``(D, K)``.
+    """
+
+    def __init__(self, models, slices):
+        self._models = tuple(models)
+        self._slices = tuple(slices)
+        width = max((part.stop for part in self._slices), default=0)
+        blocks = {"norm": [], "max": []}
+        self._fallback = []
+        for i, (model, part) in enumerate(zip(self._models, self._slices, strict=True)):
+            terms = model.gauge_terms() if part.stop > part.start else None
+            if terms is None:
+                self._fallback.append(i)
+                continue
+            for kind, matrix in terms:
+                placed = np.zeros((len(matrix), width))
+                placed[:, part] = matrix
+                blocks[kind].append((placed, i))
+        self._terms = {kind: _stacked(found, len(self._models)) for kind, found in blocks.items()}
+
+    def gauges(self, friction: np.ndarray) -> np.ndarray:
+        """Gauges ``(C, K)`` at unit normal force of the loads ``friction`` ``(D, K)``: NaN for
+        the contacts asked one by one."""
+        out = np.zeros((len(self._models), friction.shape[1]))
+        norm, largest = self._terms["norm"], self._terms["max"]
+        if norm is not None:
+            rows, starts, owners = norm
+            values = rows @ friction
+            out += owners @ np.sqrt(np.add.reduceat(values * values, starts, axis=0))
+        if largest is not None:
+            rows, starts, owners = largest
+            out += owners @ np.maximum.reduceat(rows @ friction, starts, axis=0)
+        out[self._fallback] = np.nan
+        return out
+
+    def __call__(self, friction: np.ndarray, normal: np.ndarray, *, noise: float) -> np.ndarray:
+        """Use ``(C, K)`` of loads ``friction`` ``(D, K)`` at normal forces ``normal`` ``(C, K)``
+        [N]: 1 on the limit; 0 where the load and the normal force are within ``noise`` [N] of
+        0 (solver noise); ``inf`` for a load on a contact without normal force or friction."""
+        use = np.zeros(normal.shape)
+        carried = np.zeros(normal.shape)
+        for i, part in enumerate(self._slices):
+            if part.stop > part.start:
+                carried[i] = np.abs(friction[part]).max(axis=0)
+        carries = carried > noise
+        pressed = carries & (normal > noise)
+        use[carries & ~pressed] = np.inf
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = self.gauges(friction) / normal
+        use[pressed] = ratio[pressed]
+        for i in self._fallback:
+            if pressed[i].any():
+                use[i, pressed[i]] = friction_use(
+                    self._models[i], friction[self._slices[i]].T[pressed[i]], normal[i, pressed[i]]
+                )
+        return use
+
+
+def friction_use(model: FrictionModel, load: np.ndarray, normal_force: np.ndarray) -> np.ndarray:
+    """Fraction of its friction set that each load ``(K, d)`` uses at ``normal_force`` ``(K,)``
+    (positive) [N], from the model's ``safety_factor``."""
+    per_unit = load / normal_force[:, None]  # the model at unit normal force
+    safety = np.atleast_1d(model.safety_factor(per_unit, normal_force=1.0))
+    with np.errstate(divide="ignore"):
+        return 1.0 / safety
+
+
+def _stacked(found: list, contacts: int):
+    """The terms of one kind as stacked rows ``(R, D)``, the first row of each term and the map
+    ``(C, T)`` from terms to their contacts; ``None`` without terms."""
+    if not found:
+        return None
+    sizes = [len(placed) for placed, _ in found]
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    owners = sp.csr_array(
+        (np.ones(len(found)), ([owner for _, owner in found], np.arange(len(found)))),
+        shape=(contacts, len(found)),
+    )
+    return sp.csr_array(np.vstack([placed for placed, _ in found])), starts, owners
