@@ -12,7 +12,7 @@ from fixplan.models import Ellipsoid
 from fixplan.planner.contact_surface import ContactSetSurface
 from fixplan.planner.planner import Planner, solve
 from fixplan.planner.problem import Body, Contact, Load, Problem, ProblemError
-from fixplan.planner.verify import verify
+from fixplan.planner.verify import Verifier
 
 MU, RADIUS, HALF_GAP = 0.5, 0.01, 0.02
 WEIGHTLESS = Body(mass=0.0, center_of_mass=[0, 0, 0])
@@ -235,8 +235,8 @@ def test_verification_flags_a_wrench_outside_its_friction_set():
     friction = np.array([[0.0], [5.0], [0.0], [6.0]])  # 6 N > mu * 10 N on the second finger
     wrenches = np.column_stack([off_axis_load(offset=0.0).wrench])
     answer = {"normal": normal, "friction": friction, "scale": np.ones(1)}
-    _, problems = verify(
-        planner.problem, planner.layout, planner.friction_use, answer, wrenches, 0.02
+    _, problems = Verifier(planner.problem, planner.layout, planner.friction_use, 0.02)(
+        answer, wrenches
     )
     assert any("'right' exceeds its friction set" in p for p in problems)
 
@@ -247,8 +247,8 @@ def test_verification_flags_a_pulling_contact_and_friction_without_normal_force(
     friction = np.array([[0.0], [0.0], [2.0], [0.0]])  # yet carries 2 N
     wrenches = np.column_stack([off_axis_load(offset=0.0).wrench])
     answer = {"normal": normal, "friction": friction, "scale": np.ones(1)}
-    _, problems = verify(
-        planner.problem, planner.layout, planner.friction_use, answer, wrenches, 0.02
+    _, problems = Verifier(planner.problem, planner.layout, planner.friction_use, 0.02)(
+        answer, wrenches
     )
     assert any("'left' pulls: normal force -1 N" in p for p in problems)
     assert any("'right' carries friction without normal force" in p for p in problems)

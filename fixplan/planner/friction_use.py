@@ -14,6 +14,10 @@ import scipy.sparse as sp
 
 from fixplan.models.base import FrictionModel
 
+#: Stacked term matrices up to this many entries are kept dense (a sparse product costs about
+#: 10 µs of overhead, as much as a dense one of this size).
+DENSE_MAX_ENTRIES = 20_000
+
 
 class FrictionUse:
     """The fraction of its friction set that each contact's friction load uses.
@@ -33,7 +37,7 @@ class FrictionUse:
         blocks = {"norm": [], "max": []}
         self._fallback = []
         for i, (model, part) in enumerate(zip(self._models, self._slices, strict=True)):
-            terms = model.gauge_terms() if part.stop > part.start else None
+            terms = model.gauge_terms()
             if terms is None:
                 self._fallback.append(i)
                 continue
@@ -42,6 +46,7 @@ class FrictionUse:
                 placed[:, part] = matrix
                 blocks[kind].append((placed, i))
         self._terms = {kind: _stacked(found, len(self._models)) for kind, found in blocks.items()}
+        self._starts = np.array([part.start for part in self._slices], dtype=np.intp)
 
     def gauges(self, friction: np.ndarray) -> np.ndarray:
         """Gauges ``(C, K)`` at unit normal force of the loads ``friction`` ``(D, K)``: NaN for
@@ -63,11 +68,7 @@ class FrictionUse:
         [N]: 1 on the limit; 0 where the load and the normal force are within ``noise`` [N] of
         0 (solver noise); ``inf`` for a load on a contact without normal force or friction."""
         use = np.zeros(normal.shape)
-        carried = np.zeros(normal.shape)
-        for i, part in enumerate(self._slices):
-            if part.stop > part.start:
-                carried[i] = np.abs(friction[part]).max(axis=0)
-        carries = carried > noise
+        carries = np.maximum.reduceat(np.abs(friction), self._starts, axis=0) > noise
         pressed = carries & (normal > noise)
         use[carries & ~pressed] = np.inf
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -101,4 +102,7 @@ def _stacked(found: list, contacts: int):
         (np.ones(len(found)), ([owner for _, owner in found], np.arange(len(found)))),
         shape=(contacts, len(found)),
     )
-    return sp.csr_array(np.vstack([placed for placed, _ in found])), starts, owners
+    rows = np.vstack([placed for placed, _ in found])
+    if rows.size <= DENSE_MAX_ENTRIES:  # small products are faster dense
+        return rows, starts, owners.toarray()
+    return sp.csr_array(rows), starts, owners

@@ -43,7 +43,7 @@ from fixplan.planner.problem import (
 from fixplan.planner.runner import SOLVERS, Runner
 from fixplan.planner.squeeze import squeezing, unload_squeezes
 from fixplan.planner.stacking import REFINE, ContactLayout
-from fixplan.planner.verify import verify
+from fixplan.planner.verify import Verifier
 
 
 class Planner:
@@ -77,6 +77,7 @@ class Planner:
         spread = np.linalg.norm(positions - problem.body.center_of_mass, axis=1)
         self.length_scale = float(max(spread.max(), 1e-3))
         self._passive = np.array([c.role in PASSIVE_ROLES for c in problem.contacts])
+        self._verify = Verifier(problem, self.layout, self.friction_use, self.length_scale)
         passive_map = self.layout.normal_map[:, self._passive]
         squeezable = np.zeros(len(problem.contacts), dtype=bool)
         if not allow_squeeze:
@@ -126,21 +127,12 @@ class Planner:
         if status not in ("optimal", "inaccurate"):
             notes += self._squeeze_notes(squeezed)
             return self._plan(status, None, result["solver"], start, notes, fields)
-        residual, problems = verify(
-            self.problem, self.layout, self.friction_use, result, wrenches, self.length_scale
-        )
+        residual, problems = self._verify(result, wrenches)
         if problems and result["solver"].startswith("CLARABEL"):
             retry = self._squeeze_free(objective, wrenches, given, squeezed, accurate=True)
             if retry["status"] == "optimal":
                 result = self._refine(objective, retry, wrenches, given, squeezed)
-                residual, problems = verify(
-                    self.problem,
-                    self.layout,
-                    self.friction_use,
-                    result,
-                    wrenches,
-                    self.length_scale,
-                )
+                residual, problems = self._verify(result, wrenches)
         if problems:
             status = "inaccurate"
             notes += problems

@@ -119,6 +119,11 @@ class Runner:
         """
         cases = wrenches.shape[1]
         block = self.block_size(objective)
+        if cases == block:  # one block, no padding (re-solves in a control loop)
+            result = self._run_block(objective, wrenches, given, sense, unloaded, accurate)
+            if progress is not None:
+                progress(cases, cases)
+            return result
         results = []
         for start in range(0, cases, block):
             index = np.arange(start, min(start + block, cases))
