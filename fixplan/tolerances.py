@@ -97,6 +97,19 @@ MAX_MASS = 1e7
 #: Largest gravitational acceleration [m/s²] (about 100 g).
 MAX_ACCELERATION = 1e3
 
+#: Largest angular velocity [rad/s] of a load's body motion (about 100,000 rpm).
+MAX_ANGULAR_VELOCITY = 1e4
+
+#: Largest angular acceleration [rad/s²] of a load's body motion.
+MAX_ANGULAR_ACCELERATION = 1e6
+
+#: Largest entry of an inertia tensor [kg m²] (``MAX_MASS`` at ``MAX_LENGTH``).
+MAX_INERTIA = MAX_MASS * MAX_LENGTH**2
+
+#: An inertia tensor's asymmetry and its principal moments' breach of the triangle inequality
+#: may be this fraction of its largest entry (rounding of a tensor typed or computed elsewhere).
+INERTIA_RTOL = 1e-9
+
 #: Largest friction coefficient (real ones are below about 5; a gecko pad is about 10).
 MAX_MU = 100.0
 

@@ -236,7 +236,7 @@ def analyse(
     passive = np.array([c.role in PASSIVE_ROLES for c in contacts])
     clamp = np.array([c.role == "clamp" for c in contacts])
     gravity = _about(problem.body.weight_wrench[:, None], centre)[:, 0]
-    tasks = [_about(load.wrench[:, None], centre)[:, 0] for load in problem.loads]
+    tasks = list(_about(problem.task_wrenches(), centre).T)
     preloads = [_preloads(problem, forces, index) for index in range(len(problem.loads))]
     models = [contact_model(c) for c in contacts]
     scale = max(np.abs(np.r_[gravity[:3], np.ravel(preloads), np.ravel(tasks)]).max(), 1.0)

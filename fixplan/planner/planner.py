@@ -109,7 +109,7 @@ class Planner:
         start = time.perf_counter()
         objective = SOLVED_AS.get(self.problem.objective, self.problem.objective)
         names = tuple(x.name for x in loads)
-        wrenches = np.column_stack([load.wrench for load in loads])
+        wrenches = self.problem.task_wrenches(loads)
         given = {i: c.force for i, c in enumerate(self.problem.contacts) if c.force is not None}
         squeezed: dict[str, tuple[str, ...]] = {}
         result = self._squeeze_free(objective, wrenches, given, squeezed, progress=progress)

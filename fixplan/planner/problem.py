@@ -14,11 +14,16 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError
+from fixplan.planner.mesh_body import mass_properties, read_mesh
 from fixplan.surface.pressure import PressureField
 from fixplan.tolerances import (
+    INERTIA_RTOL,
     MAX_ACCELERATION,
+    MAX_ANGULAR_ACCELERATION,
+    MAX_ANGULAR_VELOCITY,
     MAX_FACETS,
     MAX_FORCE,
+    MAX_INERTIA,
     MAX_LENGTH,
     MAX_MASS,
     MAX_MU,
@@ -119,6 +124,39 @@ def _name(where: str, value: object) -> str:
     return value
 
 
+def box_inertia(mass: float, size: np.ndarray) -> np.ndarray:
+    """Inertia tensor [kg m²] of a uniform box of ``mass`` [kg] and edges ``size`` [m] along the
+    world axes, about its centre."""
+    squares = np.asarray(size, dtype=float) ** 2
+    return np.diag(mass / 12.0 * (squares.sum() - squares))
+
+
+def _inertia(where: str, value: object) -> np.ndarray:
+    """A physical inertia tensor [kg m²]: symmetric, its principal moments >= 0 and each at most
+    the sum of the other two (within ``INERTIA_RTOL`` of the largest)."""
+    try:
+        array = validation.finite_array(where, value, shape=(3, 3))
+    except InvalidArgumentError as exc:
+        raise ProblemError(str(exc)) from None
+    size = float(np.abs(array).max())
+    if size > MAX_INERTIA:
+        raise ProblemError(f"{where} must have entries within ±{MAX_INERTIA:g} kg m², got {size:g}")
+    if np.abs(array - array.T).max() > INERTIA_RTOL * size:
+        raise ProblemError(f"{where} must be symmetric, got {array.tolist()}")
+    array = 0.5 * (array + array.T)
+    moments = np.linalg.eigvalsh(array)
+    if (
+        moments[0] < -INERTIA_RTOL * size
+        or moments[2] > moments[0] + moments[1] + INERTIA_RTOL * size
+    ):
+        raise ProblemError(
+            f"{where} is not the inertia of a body: its principal moments {moments.tolist()} "
+            "kg m² must be >= 0 and each at most the sum of the other two"
+        )
+    array.setflags(write=False)
+    return array
+
+
 def default_axis(normal: np.ndarray) -> np.ndarray:
     """The default patch x axis: the world axis least aligned with ``normal`` (x, then y, then
     z on ties), projected onto the contact plane and normalised."""
@@ -139,12 +177,55 @@ class Body:
         Centre of mass in the world frame [m].
     gravity : array (3,)
         Gravitational acceleration [m/s²]; zero turns gravity off.
+    inertia : array (3, 3), optional
+        Inertia tensor about the centre of mass, world axes [kg m²] (symmetric, positive
+        semidefinite, principal moments obeying the triangle inequality). Default: that of a
+        uniform box of ``size`` if given, else none (loads with angular terms then need one).
+    size : array (3,), optional
+        Edge lengths [m] of the body as a box along the world axes (its default inertia).
+    mesh : trimesh.Trimesh, optional
+        The closed surface of the body, in the world frame (:meth:`from_mesh`).
     """
 
     mass: float
     center_of_mass: np.ndarray
     gravity: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, -9.81]))
+    inertia: np.ndarray | None = None
+    size: np.ndarray | None = None
+    mesh: object = field(default=None, repr=False, compare=False)
     _weight: np.ndarray = field(init=False, repr=False, compare=False)
+
+    @classmethod
+    def from_mesh(
+        cls,
+        source,
+        *,
+        density: float | None = None,
+        mass: float | None = None,
+        scale: float = 1.0,
+        gravity=(0.0, 0.0, -9.81),
+    ) -> Body:
+        """The uniform solid bounded by a closed triangle mesh (a file path, STL/OBJ/PLY/…,
+        or a ``trimesh.Trimesh``) in world coordinates times ``scale`` [m]: its mass (from
+        ``density`` [kg/m³] or given as ``mass`` [kg]), centre of mass and inertia tensor.
+
+        Raises :class:`~fixplan.planner.mesh_body.MeshError` for a mesh that is not a solid (not
+        watertight, inconsistent or inverted normals, zero volume).
+        """
+        mesh = read_mesh(source, scale=scale)
+        total, center, inertia = mass_properties(mesh, density=density, mass=mass)
+        return cls(mass=total, center_of_mass=center, gravity=gravity, inertia=inertia, mesh=mesh)
+
+    def inertial_wrench(self, load: Load) -> np.ndarray:
+        """The d'Alembert wrench ``(-m a, c × (-m a) - (I α + ω × I ω))`` [N, N m about the world
+        origin] of ``load``'s motion of the body (all world frame)."""
+        force = -self.mass * load.acceleration
+        moment = np.cross(self.center_of_mass, force)
+        if load.rotates:
+            inertia = self.inertia
+            spin = inertia @ load.angular_velocity
+            moment -= inertia @ load.angular_acceleration + np.cross(load.angular_velocity, spin)
+        return np.concatenate([force, moment])
 
     def __post_init__(self):
         mass = _scalar("body.mass", self.mass, limit=MAX_MASS, units="kg")
@@ -157,6 +238,17 @@ class Body:
         weight = np.concatenate([force, np.cross(center, force)])
         weight.setflags(write=False)
         object.__setattr__(self, "_weight", weight)
+        if self.size is not None:
+            size = _vector("body.size", self.size, limit=MAX_LENGTH, units="m")
+            if np.any(size <= 0.0):
+                raise ProblemError(
+                    f"body.size must have positive edge lengths, got {size.tolist()}"
+                )
+            object.__setattr__(self, "size", size)
+        if self.inertia is not None:
+            object.__setattr__(self, "inertia", _inertia("body.inertia", self.inertia))
+        elif self.size is not None:
+            object.__setattr__(self, "inertia", box_inertia(mass, self.size))
 
     @property
     def weight_wrench(self) -> np.ndarray:
@@ -166,22 +258,42 @@ class Body:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Load:
-    """A task load: ``force`` [N] applied at ``point`` [m] plus a pure ``torque`` [N m]."""
+    """A task load: ``force`` [N] applied at ``point`` [m] plus a pure ``torque`` [N m], while
+    the body moves with ``acceleration`` [m/s²] of its centre of mass, ``angular_velocity``
+    [rad/s] and ``angular_acceleration`` [rad/s²] (world frame; default at rest).
+
+    The motion adds the body's d'Alembert wrench (:meth:`Body.inertial_wrench`) to the case's
+    task wrench (:meth:`Problem.task_wrenches`): safety factors scale it with the applied load,
+    while gravity stays as it is.
+    """
 
     name: str
-    force: np.ndarray
-    point: np.ndarray
+    force: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    point: np.ndarray = field(default_factory=lambda: np.zeros(3))
     torque: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    acceleration: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    angular_velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    angular_acceleration: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
     def __post_init__(self):
         where = f"load {self.name!r}" if isinstance(self.name, str) else "load"
         _name(f"{where}.name", self.name)
-        force = _vector(f"{where}.force", self.force, limit=MAX_FORCE, units="N")
-        point = _vector(f"{where}.point", self.point, limit=MAX_LENGTH, units="m")
-        torque = _vector(f"{where}.torque", self.torque, limit=MAX_TORQUE, units="N m")
-        object.__setattr__(self, "force", force)
-        object.__setattr__(self, "point", point)
-        object.__setattr__(self, "torque", torque)
+        limits = {
+            "force": (MAX_FORCE, "N"),
+            "point": (MAX_LENGTH, "m"),
+            "torque": (MAX_TORQUE, "N m"),
+            "acceleration": (MAX_ACCELERATION, "m/s²"),
+            "angular_velocity": (MAX_ANGULAR_VELOCITY, "rad/s"),
+            "angular_acceleration": (MAX_ANGULAR_ACCELERATION, "rad/s²"),
+        }
+        for key, (limit, units) in limits.items():
+            value = _vector(f"{where}.{key}", getattr(self, key), limit=limit, units=units)
+            object.__setattr__(self, key, value)
+
+    @property
+    def rotates(self) -> bool:
+        """Whether the load has an angular velocity or acceleration (needs the body's inertia)."""
+        return bool(np.any(self.angular_velocity) or np.any(self.angular_acceleration))
 
     @property
     def wrench(self) -> np.ndarray:
@@ -408,3 +520,22 @@ class Problem:
             )
         object.__setattr__(self, "contacts", contacts)
         object.__setattr__(self, "loads", loads)
+        self.task_wrenches()  # loads that need the body's inertia
+
+    def task_wrenches(self, loads: tuple[Load, ...] | None = None) -> np.ndarray:
+        """Task wrenches ``(6, K)`` [N, N m about the world origin] of ``loads`` (default the
+        problem's): each load's applied wrench plus the body's d'Alembert wrench of its motion
+        (gravity is not included)."""
+        loads = self.loads if loads is None else loads
+        columns = []
+        for load in loads:
+            wrench = load.wrench
+            if load.rotates or np.any(load.acceleration):
+                if load.rotates and self.body.inertia is None:
+                    raise ProblemError(
+                        f"load {load.name!r} has an angular velocity or acceleration: the body "
+                        "needs an inertia tensor (body.inertia, body.size or a mesh)"
+                    )
+                wrench = wrench + self.body.inertial_wrench(load)
+            columns.append(wrench)
+        return np.column_stack(columns)
