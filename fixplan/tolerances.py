@@ -97,6 +97,9 @@ MAX_MASS = 1e7
 #: Largest gravitational acceleration [m/s²] (about 100 g).
 MAX_ACCELERATION = 1e3
 
+#: Largest density [kg/m³] of a body read from a mesh (osmium, the densest element: 22,590).
+MAX_DENSITY = 1e5
+
 #: Largest angular velocity [rad/s] of a load's body motion (about 100,000 rpm).
 MAX_ANGULAR_VELOCITY = 1e4
 

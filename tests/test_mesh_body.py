@@ -87,7 +87,7 @@ def test_a_flat_or_unreadable_mesh_and_a_wrong_mass_are_refused(tmp_path):
     with pytest.raises(MeshError, match="zero volume"):
         read_mesh(trimesh.creation.box(extents=[1.0, 1.0, 0.0]))
     (tmp_path / "bad.stl").write_text("not a mesh")
-    with pytest.raises(MeshError, match="bad.stl"):
+    with pytest.raises(MeshError, match=r"bad\.stl"):
         read_mesh(tmp_path / "bad.stl")
     box = trimesh.creation.box(extents=[1.0, 1.0, 1.0])
     with pytest.raises(MeshError, match="exactly one of density"):

@@ -110,6 +110,7 @@ EXPECTED = {
         },
     ),
     "point-grasp": Expected(status="optimal", objective_value=37.025, safety_factor=1.0),
+    "pick-and-place": Expected(status="optimal", objective_value=7.905, safety_factor=1.0),
     "unholdable": Expected(
         status="infeasible", free_axis=(0.0, 1.0, 0.0), free_point=(0.0, 0.0, 0.0)
     ),
@@ -253,6 +254,25 @@ def test_hertz_pinch_needs_the_ellipsoid_closed_form_grip_force():
         expected = math.hypot(f / finger.mu, m / (finger.mu * k * finger.patch.radius))
         for name in ("finger-left", "finger-right"):
             assert plan.forces[name][j] == pytest.approx(expected, rel=1e-6), (load, name)
+
+
+def test_pick_and_place_grip_is_the_closed_form_of_each_phase_of_the_motion():
+    # Only the block's motion loads the grasp: F = m |g - a| in the fingers' plane and
+    # M = I_yy α_y about the grasp axis (a uniform box: I_yy = m (a² + c²) / 12), with the same
+    # ellipsoid closed form as the Hertz pinch; written out from the file's numbers.
+    problem_file, plan = _solved("pick-and-place")
+    document = tomllib.loads((PROBLEMS / "pick-and-place.toml").read_text(encoding="utf-8"))
+    mass, (a, _, c) = document["body"]["mass"], document["body"]["size"]
+    mu, radius, k = 0.8, 0.006, 3.0 * math.pi / 16.0
+    for j, load in enumerate(document["loads"]):
+        ax, _, az = load.get("acceleration", [0.0, 0.0, 0.0])
+        alpha = load.get("angular_acceleration", [0.0, 0.0, 0.0])[1]
+        force = mass * math.hypot(ax, 9.81 + az)
+        moment = mass * (a * a + c * c) / 12.0 * alpha
+        expected = math.hypot(force / 2 / mu, moment / 2 / (mu * k * radius))
+        for name in ("finger-left", "finger-right"):
+            assert plan.forces[name][j] == pytest.approx(expected, rel=1e-6), (load["name"], name)
+    assert problem_file.problem.body.inertia[1, 1] == pytest.approx(mass * (a * a + c * c) / 12)
 
 
 def test_hertz_pinch_ellipsoid_is_within_half_a_percent_of_the_exact_limit_surface():

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import ctypes
+import dataclasses
 import functools
 import importlib
 import json
@@ -433,14 +434,29 @@ def _run_plan(args: argparse.Namespace) -> tuple[int, str]:
         document = plan.as_dict()
         document["problem"] = {"name": problem_file.name, "file": str(problem_file.path),
                                "sha256": problem_file.sha256}  # fmt: skip
+        if problem_file.surface_contacts:
+            document["problem"]["surface_contacts"] = {
+                name: dataclasses.asdict(placed)
+                for name, placed in problem_file.surface_contacts.items()
+            }
         if compliant:
             document["compliant"] = summary
         output = _json(document)
     else:
-        output = "\n".join([_summary(problem_file, plan), *lines])
+        output = "\n".join([_summary(problem_file, plan), *_surface_lines(problem_file), *lines])
     clock.lap("output")
     log.info("time: %s", clock)
     return _exit_code(plan), output
+
+
+def _surface_lines(problem_file) -> list[str]:
+    """Where the contacts given by ``on_surface`` were placed on the body's mesh."""
+    return [
+        f"contact {name!r} on the mesh surface at ({', '.join(f'{x:.6g}' for x in p.position)}) m, "
+        f"normal ({', '.join(f'{x:.4g}' for x in p.normal)}), {p.distance * 1e3:.3g} mm from "
+        "the point given"
+        for name, p in problem_file.surface_contacts.items()
+    ]
 
 
 # -- push ----------------------------------------------------------------------------------------

@@ -20,12 +20,22 @@ SI throughout. The schema::
     mass = 2.0                            # [kg], required
     center_of_mass = [0.0, 0.0, 0.02]     # [m], required
     gravity = [0.0, 0.0, -9.81]           # [m/s^2], optional (default that)
+    inertia = [[0.01, 0, 0], [0, 0.02, 0], [0, 0, 0.02]]  # [kg m^2] about the centre of
+                                          # mass, optional (needed by turning loads)
+    size = [0.15, 0.1, 0.03]              # [m], optional: a box; its inertia is the default
+
+    # or a body from a closed mesh (its mass properties computed, no center_of_mass/inertia):
+    # mesh = "part.stl"                   # relative to this file; STL, OBJ, PLY, ...
+    # density = 7850.0                    # [kg/m^3], or mass = ... [kg] (exactly one)
+    # mesh_scale = 0.001                  # [m per mesh unit], optional (1: metres)
 
     [[contacts]]                          # at least one
     name = "jaw-fixed"                    # required, unique
     role = "locator"                      # locator | support | clamp | finger
     position = [-0.05, 0.0, 0.02]         # [m]
     normal = [1.0, 0.0, 0.0]              # into the body, a unit vector
+    # on_surface = [-0.05, 0.0, 0.02]     # instead of position and normal, with a mesh body:
+                                          # the closest surface point, its inward normal
     mu = 0.25                             # >= 0 (0: frictionless); required unless
                                           # [defaults] gives it
     model = "exact"                       # exact | ellipsoid | cone | pyramid | point-cone
@@ -45,9 +55,12 @@ SI throughout. The schema::
 
     [[loads]]                             # at least one
     name = "face-mill-pass-1"             # required, unique
-    force = [120.0, -40.0, -60.0]         # [N], required
-    point = [0.03, 0.0, 0.04]             # [m], required
+    force = [120.0, -40.0, -60.0]         # [N], optional (default 0)
+    point = [0.03, 0.0, 0.04]             # [m], required with force
     torque = [0.0, 0.0, 1.5]              # [N m], optional
+    acceleration = [0.0, 0.0, 5.0]        # [m/s^2] of the centre of mass, optional: the body
+    angular_velocity = [0.0, 0.0, 2.0]    # [rad/s] and angular acceleration [rad/s^2] move,
+    angular_acceleration = [0.0, 0.0, 8.0]  # optional; their d'Alembert wrench joins the load
 
 A contact's **stiffness** (:class:`fixplan.motion.Stiffness`) is its own table, else the one of
 ``[defaults]`` (a contact's table replaces it whole). Stiffnesses feed the compliant analysis
@@ -90,7 +103,7 @@ from pathlib import Path
 import numpy as np
 
 from fixplan import validation
-from fixplan.errors import InvalidArgumentError
+from fixplan.errors import FixplanError, InvalidArgumentError
 from fixplan.io.patch_schema import read_patch
 from fixplan.io.toml_schema import (
     MAX_FILE_BYTES,
@@ -110,11 +123,13 @@ from fixplan.io.toml_schema import (
     check_schema_version,
     check_unique_names,
     describe,
+    given,
     parse_toml,
     read_regular_file,
 )
 from fixplan.motion import Fit, FittedQuartic, Stiffness
 from fixplan.planner.contact_models import contact_model
+from fixplan.planner.mesh_body import surface_contact
 from fixplan.planner.problem import (
     AREA_MODEL_NAMES,
     COMPLIANT_OBJECTIVE,
@@ -129,8 +144,12 @@ from fixplan.planner.problem import (
 )
 from fixplan.tolerances import (
     MAX_ACCELERATION,
+    MAX_ANGULAR_ACCELERATION,
+    MAX_ANGULAR_VELOCITY,
+    MAX_DENSITY,
     MAX_FACETS,
     MAX_FORCE,
+    MAX_INERTIA,
     MAX_LENGTH,
     MAX_MASS,
     MAX_MU,
@@ -141,6 +160,8 @@ from fixplan.tolerances import (
 )
 
 KINDS = ("fixture", "grasp")
+#: Largest mesh file of a body read [bytes] (a finely tessellated part of a few million faces).
+MAX_MESH_BYTES = 200_000_000
 #: The model of a contact whose friction set is a saved fit (its ``fit`` key names the file).
 FITTED = "fitted"
 PYRAMID_MODEL_NAMES = ("pyramid", "point-pyramid")
@@ -181,6 +202,7 @@ _DEFAULT_KEYS = ("mu", "model", "facets", "inscribed", "stiffness")
 _CONTACT_KEYS = (
     "name",
     "role",
+    "on_surface",
     "position",
     "normal",
     "mu",
@@ -195,6 +217,18 @@ _CONTACT_KEYS = (
     "max_force",
     "stiffness",
 )
+
+
+@dataclass(frozen=True, slots=True)
+class SurfaceContact:
+    """Where a contact given by ``on_surface`` sits on the body's mesh: the ``requested`` point,
+    the closest surface ``position`` and its inward ``normal`` (world frame), and the
+    ``distance`` between the two points [m]."""
+
+    requested: tuple[float, float, float]
+    position: tuple[float, float, float]
+    normal: tuple[float, float, float]
+    distance: float
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -218,6 +252,8 @@ class ProblemFile:
     stiffness : dict or None
         :class:`~fixplan.motion.Stiffness` by contact name, for the contacts the file gives one
         (their own or ``[defaults]``'); ``None`` when it gives none.
+    surface_contacts : dict
+        :class:`SurfaceContact` by contact name, for the contacts placed with ``on_surface``.
     """
 
     problem: Problem
@@ -227,6 +263,7 @@ class ProblemFile:
     sha256: str
     model_override: str | None = None
     stiffness: dict[str, Stiffness] | None = None
+    surface_contacts: dict[str, SurfaceContact] = field(default_factory=dict)
 
 
 def load_problem(
@@ -282,6 +319,7 @@ def load_problem(
         sha256=hashlib.sha256(content).hexdigest(),
         model_override=model,
         stiffness=reader.stiffness or None,
+        surface_contacts=reader.surface_contacts,
     )
 
 
@@ -341,8 +379,28 @@ _TANGENTIAL_STIFFNESS = Number(
 _TORSIONAL_STIFFNESS = Number(
     ">= 0", MAX_STIFFNESS, "N m/rad", smallest=MIN_STIFFNESS, why_smallest=_SOFTEST + "; or give 0)"
 )
-_BODY_KINDS = {"mass": _MASS, "center_of_mass": _POSITION, "gravity": _GRAVITY}
-_LOAD_KINDS = {"name": _NAME, "force": _FORCE_VECTOR, "point": _POSITION, "torque": _TORQUE_VECTOR}
+_INERTIA = Array((3, 3), Number("", MAX_INERTIA, "kg m^2"))
+_SIZE = Array((3,), Number("> 0", MAX_LENGTH, "m"))
+_DENSITY = Number("> 0", MAX_DENSITY, "kg/m^3")
+_MESH_SCALE = Number("> 0", MAX_LENGTH, "m per mesh unit")
+_BODY_KINDS = {
+    "mass": _MASS,
+    "center_of_mass": _POSITION,
+    "gravity": _GRAVITY,
+    "inertia": _INERTIA,
+    "size": _SIZE,
+}
+_MESH_BODY_KINDS = {"mesh": _TEXT, "density": _DENSITY, "mass": _MASS, "mesh_scale": _MESH_SCALE,
+                    "gravity": _GRAVITY}  # fmt: skip
+_LOAD_KINDS = {
+    "name": _NAME,
+    "force": _FORCE_VECTOR,
+    "point": _POSITION,
+    "torque": _TORQUE_VECTOR,
+    "acceleration": _GRAVITY,
+    "angular_velocity": Array((3,), Number("", MAX_ANGULAR_VELOCITY, "rad/s")),
+    "angular_acceleration": Array((3,), Number("", MAX_ANGULAR_ACCELERATION, "rad/s^2")),
+}
 _STIFFNESS_KINDS = {
     "normal": _NORMAL_STIFFNESS,
     "tangential": _TANGENTIAL_STIFFNESS,
@@ -368,6 +426,9 @@ class _Reader:
         self.issues: list[Issue] = []
         self.stiffness: dict[str, Stiffness] = {}  # by contact name
         self.fits: dict[tuple[str, int | None], object] = {}  # planner models of fits read
+        self.mesh = None  # the body's mesh, for contacts on its surface
+        self.mesh_declared = False  # whether the file names one (read or not)
+        self.surface_contacts: dict[str, SurfaceContact] = {}
 
     def document(self, data: dict) -> tuple[str | None, str | None, Problem | None]:
         """The file's name, kind and problem (``None`` where invalid)."""
@@ -384,7 +445,10 @@ class _Reader:
         if "description" in data and not isinstance(data["description"], str):
             top.report("description", f"expected a string, got {describe(data['description'])}")
         defaults = self._defaults(top.table("defaults"))
-        body = self._body(top.table("body", required=True))
+        body_table = top.table("body", required=True)
+        body = self._body(body_table)
+        self.mesh = None if body is None else body.mesh
+        self.mesh_declared = body_table is not None and "mesh" in body_table.data
         contact_tables = top.tables("contacts")
         contacts = [self._contact(table, defaults) for table in contact_tables]
         check_unique_names(contact_tables, "contact")
@@ -444,18 +508,50 @@ class _Reader:
     def _body(self, table: Table | None) -> Body | None:
         if table is None:
             return None
-        return table.read(Body, _BODY_KINDS, required=("mass", "center_of_mass"))
+        if "mesh" not in table.data:
+            for key in ("density", "mesh_scale"):
+                if key in table.data:
+                    table.report(key, 'only for a body read from a mesh (give mesh = "...")')
+            return table.read(Body, _BODY_KINDS, required=("mass", "center_of_mass"))
+        for key in ("center_of_mass", "inertia", "size"):
+            if key in table.data:
+                table.report(key, "not with a mesh: the mesh gives the body's mass properties")
+        if ("mass" in table.data) == ("density" in table.data):
+            table.report("mesh", "give exactly one of density [kg/m^3] and mass [kg] with a mesh")
+        start = len(self.issues)
+        table.check_keys(tuple(_MESH_BODY_KINDS))
+        values = {key: table.get(key, kind) for key, kind in _MESH_BODY_KINDS.items()}
+        if len(self.issues) > start:
+            return None
+        path = self.folder / values.pop("mesh")
+        scale = values.pop("mesh_scale") or 1.0
+        try:
+            read_regular_file(path, MAX_MESH_BYTES)
+        except InvalidValueError as exc:
+            table.report("mesh", f"cannot read {path.name!r}: {exc}")
+            return None
+        try:
+            return Body.from_mesh(path, scale=scale, **given(**values))
+        except FixplanError as exc:
+            table.report("mesh", str(exc))
+            return None
 
     def _load(self, table: Table) -> Load | None:
-        return table.read(Load, _LOAD_KINDS, required=("name", "force", "point"))
+        if "force" in table.data and "point" not in table.data:
+            table.report("point", "missing: a load's force needs the point it acts at [m]")
+            return None
+        return table.read(Load, _LOAD_KINDS, required=("name",))
 
     def _contact(self, table: Table, defaults: _Defaults) -> Contact | None:
         start = len(self.issues)
         table.check_keys(_CONTACT_KEYS)
         name = table.get("name", _NAME, required=True)
         role = table.get("role", Choice(ROLES), required=True)
-        position = table.get("position", _POSITION, required=True)
-        normal = _normal(table)
+        if "on_surface" in table.data:
+            position, normal = self._on_surface(table, name)
+        else:
+            position = table.get("position", _POSITION, required=True)
+            normal = _normal(table)
         file_model = _with_default(
             table, "model", _CONTACT_MODEL, defaults, required=self.model is None
         )
@@ -504,6 +600,27 @@ class _Reader:
             force=force,
             max_force=max_force,
         )
+
+    def _on_surface(self, table: Table, name: str | None) -> tuple[list | None, list | None]:
+        """Position and inward normal of a contact at the body's mesh surface point closest to
+        its ``on_surface`` point (recorded in :attr:`surface_contacts`)."""
+        for key in ("position", "normal"):
+            if key in table.data:
+                table.report(key, "not with on_surface: the mesh gives the contact's " + key)
+        point = table.get("on_surface", _POSITION)
+        if point is None:
+            return None, None
+        if self.mesh is None:
+            if not self.mesh_declared:  # else the mesh's own issue is reported
+                table.report("on_surface", 'needs a body read from a mesh ([body] mesh = "...")')
+            return None, None
+        position, normal, distance = surface_contact(self.mesh, point)
+        if isinstance(name, str):
+            self.surface_contacts[name] = SurfaceContact(
+                requested=tuple(point), position=tuple(position), normal=tuple(normal),
+                distance=distance,
+            )  # fmt: skip
+        return position.tolist(), normal.tolist()
 
     def _fit(self, table: Table):
         """The planner model of the contact's saved fit (``fit``, ``cuts``), or ``None`` with
