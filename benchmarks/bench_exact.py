@@ -7,7 +7,8 @@ problems, each model timed in a fresh process (peak resident memory of that proc
   20 x 20 mm), holding a weight and a torque about the grasp axis, 4 load cases; build + first
   solve and the median of 5 re-solves with new loads;
 - the fixture of ``bench_planner.py`` (8 area contacts x 20 milling loads), the same figures
-  and the number of cutting rounds of the exact model.
+  and the number of cutting rounds of the exact model, with the time per round of a re-solve
+  spent in Clarabel and in the cuts (mostly the exact inverse map's queries).
 
 The machine is shared and noisy: compare the ratios of the same run.
 """
@@ -61,10 +62,24 @@ def measure(case: str, model: str, cells: int) -> dict:
     else:
         problem = fixture(model, "min-total-clamp-force", milling_loads(20, 0))
         new_loads = lambda seed: milling_loads(20, seed)  # noqa: E731
-    rounds = []
+    rounds, spent = [], {"cuts": 0.0, "solver": 0.0}
     if model == "exact":
-        from fixplan.planner import cuts
+        from fixplan.planner import cuts, direct_solve
 
+        def timed(owner, name, key):
+            method = getattr(owner, name)
+
+            def wrapper(self, *args, **kwargs):
+                start = time.perf_counter()
+                try:
+                    return method(self, *args, **kwargs)
+                finally:
+                    spent[key] += time.perf_counter() - start
+
+            setattr(owner, name, wrapper)
+
+        timed(cuts.CutPool, "add_cuts", "cuts")
+        timed(direct_solve.DirectSolver, "solve", "solver")
         add_cuts = cuts.CutPool.add_cuts
         cuts.CutPool.add_cuts = lambda pool: rounds.append(1) or add_cuts(pool)
     start = time.perf_counter()
@@ -73,6 +88,7 @@ def measure(case: str, model: str, cells: int) -> dict:
     first = time.perf_counter() - start
     assert plan.status == "optimal", plan.status
     first_rounds, times = len(rounds), []
+    spent.update(cuts=0.0, solver=0.0)
     for seed in range(1, 6):
         loads = new_loads(seed)
         start = time.perf_counter()
@@ -84,6 +100,9 @@ def measure(case: str, model: str, cells: int) -> dict:
         "resolve": float(np.median(times)),
         "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
         "rounds": (first_rounds, (len(rounds) - first_rounds) / 5),
+        "per_round": {
+            key: value / max(len(rounds) - first_rounds, 1) for key, value in spent.items()
+        },
         "objective": plan.objective_value,
     }
 
@@ -110,7 +129,9 @@ def main() -> None:
             cutting = ""
             if model == "exact":
                 cutting = (
-                    f", cutting rounds {f['rounds'][0]} then {f['rounds'][1]:.1f} per re-solve"
+                    f", cutting rounds {f['rounds'][0]} then {f['rounds'][1]:.1f} per re-solve "
+                    f"(per round: Clarabel {f['per_round']['solver'] * 1e3:.1f} ms, cuts with "
+                    f"their inverse-map queries {f['per_round']['cuts'] * 1e3:.1f} ms)"
                 )
             print(
                 f"  {model:9s}: build + first solve {f['first']:7.3f} s, median re-solve "

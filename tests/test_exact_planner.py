@@ -176,3 +176,21 @@ def test_re_solves_keep_every_contact_load_inside_its_exact_surface():
         total = torque + weight * offset
         expected, _ = least_normal_force(weight / 2.0, abs(total) / 2.0)
         np.testing.assert_allclose(plan.normal_forces[:, 0], expected, rtol=OPTIMUM_RTOL)
+
+
+def test_the_impending_motion_of_each_pinching_finger_is_the_normal_at_its_load():
+    # Normality: at the optimum each finger's twist in the impending motion (the equilibrium's
+    # multipliers mapped to the contact, which centre the tilted cuts) is the outward normal of
+    # its exact surface at its load, i.e. the load's sliding twist from the inverse map.
+    load = Load(name="hold", force=[0, 0, -10.0], point=[0, 0, 0], torque=[0, 0.1, 0])
+    problem = pinch(load)
+    planner = Planner(problem)
+    plan = planner.solve(analyse=False)
+    assert plan.status == "optimal"
+    twists = planner._runner.stacked(problem.objective).cuts.motion_twists()[:, 0]
+    scale = np.array([1.0, 1.0, R])  # normalised twist coordinates of the disk
+    for i, contact in enumerate(problem.contacts):
+        surface = contact_model(contact).surface
+        sliding = surface.motion(plan.contact_wrenches[i, 0, 1:] / plan.normal_forces[i, 0])
+        a, b = twists[i] * scale, sliding * scale
+        assert np.dot(a, b) / (np.linalg.norm(a) * np.linalg.norm(b)) > 1.0 - 1e-6

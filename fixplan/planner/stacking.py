@@ -256,7 +256,8 @@ def build(
             limits = np.asarray(limits)
             variable = pieces[key][list(rows)]
             constraints.append(variable <= (limits[:, None] if key == "finger" else limits))
-    cuts = CutPool.of(layout.models, layout.slices, normal, friction)
+    cuts = CutPool.of(layout.models, layout.slices, normal, friction,
+                      wrenches=layout.friction_map, balance=balance)  # fmt: skip
     if cuts is not None:
         constraints.append(cuts.constraint)
     unloaded = None
