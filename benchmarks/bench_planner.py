@@ -7,11 +7,16 @@ clamp (8 area contacts), under 20 milling load cases. Medians of repeated runs.
 
 from __future__ import annotations
 
+import dataclasses
+import os
 import time
+from pathlib import Path
 
 import numpy as np
+from performance_rows import emit
 
 from fixplan import pressure
+from fixplan.io.problem_file import load_problem
 from fixplan.planner.planner import Planner
 from fixplan.planner.problem import Body, Contact, Load, Problem
 
@@ -49,6 +54,32 @@ def milling_loads(count: int, seed: int) -> list[Load]:
         torque = [0.0, 0.0, rng.normal() * 1.0]
         loads.append(Load(name=f"cut-{k}", force=force, point=point, torque=torque))
     return loads
+
+
+def fixture_321_check(count: int, seed: int) -> Problem:
+    """``problems/fixture-321.toml`` at its planned clamp forces (objective ``check``), its 12
+    cuts scaled to ``count`` load cases by random convex combinations turned about z."""
+    path = Path(__file__).resolve().parents[1] / "problems" / "fixture-321.toml"
+    problem = load_problem(path).problem
+    forces = Planner(problem).solve().forces
+    contacts = tuple(
+        dataclasses.replace(c, force=float(forces[c.name])) if c.name in forces else c
+        for c in problem.contacts
+    )
+    rng = np.random.default_rng(seed)
+    loads = []
+    for k in range(count):
+        a, b = rng.choice(len(problem.loads), 2, replace=False)
+        w, angle = rng.uniform(), rng.uniform(-np.pi, np.pi)
+        c, s = np.cos(angle), np.sin(angle)
+        turn = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        first, second = problem.loads[a], problem.loads[b]
+        loads.append(Load(
+            name=f"case-{k}", force=turn @ (w * first.force + (1 - w) * second.force),
+            point=turn @ (w * first.point + (1 - w) * second.point),
+            torque=w * first.torque + (1 - w) * second.torque,
+        ))  # fmt: skip
+    return dataclasses.replace(problem, contacts=contacts, loads=tuple(loads), objective="check")
 
 
 def timed(function):
@@ -111,6 +142,30 @@ def main() -> None:
         f"check of 1,000 load cases: {1000 / again:7.0f} cases/s ({again:.2f} s; first call "
         f"{first:.2f} s with compilation); {held} held, smallest safety factor "
         f"{plan.safety_factor:.3f}"
+    )
+
+    problem = fixture_321_check(1000, 11)
+    planner = Planner(problem)
+    planner.solve()
+    wrenches = problem.task_wrenches()
+    given = {i: c.force for i, c in enumerate(problem.contacts) if c.force is not None}
+
+    def both_ends() -> None:  # the solves of the previous planner: k_max and k_min of every case
+        for sense in (1.0, -1.0):
+            planner._runner.run("check", wrenches, given, sense=sense)
+
+    check = np.median([timed(planner.solve)[1] for _ in range(5)])
+    solves = np.median([timed(both_ends)[1] for _ in range(5)])
+    print(
+        f"check of fixture-321 x 1,000 load cases (load average {os.getloadavg()[0]:.1f}): "
+        f"{1000 / check:7.0f} cases/s, plan included; both ends of every case solved, without "
+        f"the analysis: {1000 / solves:7.0f} cases/s"
+    )
+    emit(
+        "`check` of 1,000 load cases of `problems/fixture-321.toml` (pyramids), plan included",
+        f"{1000 / check:,.0f} cases/s",
+        f"both ends of every held interval solved, no analysis: {1000 / solves:,.0f} cases/s",
+        f"{solves / check:.2f}×",
     )
 
 

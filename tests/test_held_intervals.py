@@ -77,3 +77,23 @@ def test_the_json_document_carries_the_intervals_and_their_words():
     assert document["held_intervals"]["press"] == [pytest.approx(0.5), "inf"]
     assert document["held_descriptions"]["press"] == "held for 0.5 × the task load and above"
     assert document["held"]["press"] is True
+
+
+def test_the_lower_ends_of_many_cases_are_each_cases_own():
+    """k_min is solved for one case per column of given forces and shared only where that case
+    is held without its task load: a pinch (every case held at 0) and a part pushed up (no case
+    held at 0) over several weights against their closed forms."""
+    weights = [5.0, 10.0, 40.0]
+    pinch, push = pinch_check(20.0, 1.0), push_up_check(20.0, 1.0)
+    for problem, lowest, highest in (
+        (pinch, [0.0] * 3, [2 * MU * 20.0 / w for w in weights]),
+        (push, [20.0 / w for w in weights], [np.inf] * 3),
+    ):
+        name = problem.loads[0].name
+        loads = [Load(name=f"{name}-{w:g}", force=[0, 0, -w], point=[0, 0, 0]) for w in weights]
+        plan = solve(Problem(body=WEIGHTLESS, contacts=problem.contacts, loads=loads,
+                             objective="check"))  # fmt: skip
+        for load, low, high in zip(loads, lowest, highest, strict=True):
+            got = plan.held_intervals[load.name]
+            assert got[0] == pytest.approx(low, rel=1e-6, abs=1e-9), load.name
+            assert got[1] == pytest.approx(high, rel=1e-6), load.name

@@ -44,6 +44,7 @@ from fixplan.planner.runner import SOLVERS, Runner
 from fixplan.planner.squeeze import squeezing, unload_squeezes
 from fixplan.planner.stacking import REFINE, ContactLayout
 from fixplan.planner.verify import Verifier
+from fixplan.tolerances import MULTIPLE_ATOL
 
 
 class Planner:
@@ -212,9 +213,7 @@ class Planner:
     def _intervals(self, highest, wrenches, given, squeezed, progress) -> dict:
         """Held intervals, motions and utilisation of the given forces (``highest``: the
         maximising fixed-force solve)."""
-        lowest = self._squeeze_free(
-            "check", wrenches, given, squeezed, sense=-1.0, progress=progress
-        )
+        lowest = self._lowest(wrenches, given, squeezed, progress)
         if lowest["status"] not in ("optimal", "inaccurate"):
             lowest = None
         decided = self._passive.copy()
@@ -222,6 +221,40 @@ class Planner:
             self.problem, self.layout, self.friction_use, highest, lowest, wrenches, decided,
             self.length_scale,
         )  # fmt: skip
+
+    def _lowest(self, wrenches, given, squeezed, progress) -> dict:
+        """The minimising fixed-force solve: ``scale`` holds ``k_min`` of every case.
+
+        At ``k = 0`` the task load drops out, so whether a case is held without it depends only
+        on its given forces: one case per distinct column of given forces is solved first, and
+        the cases that share a column held at 0 have ``k_min = 0`` without a solve of their own.
+        (With squeezable passive contacts every case is solved: their unloading is per case.)
+        """
+
+        def minimised(index, report=None):
+            values = {i: v if np.ndim(v) == 0 else np.asarray(v)[index] for i, v in given.items()}
+            return self._squeeze_free(
+                "check", wrenches[:, index], values, squeezed, sense=-1.0, progress=report
+            )
+
+        cases = wrenches.shape[1]
+        if self.squeeze_contacts or not given:
+            return minimised(np.arange(cases), progress)
+        columns = np.vstack([np.broadcast_to(v, (cases,)) for v in given.values()])
+        _, first, group = np.unique(columns.T, axis=0, return_index=True, return_inverse=True)
+        representatives = minimised(first)
+        if representatives["status"] not in ("optimal", "inaccurate"):
+            return minimised(np.arange(cases), progress)
+        scale = np.zeros(cases)
+        rest = np.flatnonzero(representatives["scale"][np.ravel(group)] >= MULTIPLE_ATOL)
+        if rest.size:
+            solved = minimised(rest)
+            if solved["status"] not in ("optimal", "inaccurate"):
+                return minimised(np.arange(cases), progress)
+            scale[rest] = solved["scale"]
+        if progress is not None:
+            progress(cases, cases)
+        return {"status": "optimal", "scale": scale}
 
     # -- reporting ----------------------------------------------------------------------------
 
