@@ -28,7 +28,7 @@ def _simulate(xml: str, seconds: float) -> tuple[float, float]:
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, 0)
     start, turn = data.qpos[:3].copy(), data.qpos[3:7].copy()
-    for _ in range(int(round(seconds / model.opt.timestep))):
+    for _ in range(round(seconds / model.opt.timestep)):
         mujoco.mj_step(model, data)
     assert np.all(np.isfinite(data.qpos))
     angle = 2.0 * np.arccos(min(1.0, abs(float(data.qpos[3:7] @ turn))))
@@ -47,7 +47,7 @@ def plans():
 
 
 def test_every_problem_exports_to_a_scene_that_mujoco_loads_and_runs(plans):
-    for name, (problem, plan) in plans.items():
+    for problem, plan in plans.values():
         forces = None
         if plan.status != "optimal":  # no forces to show: press every active contact with 10 N
             forces = {c.name: 10.0 for c in problem.contacts if c.is_active}
