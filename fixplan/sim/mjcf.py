@@ -16,7 +16,8 @@ The scene follows what makes MuJoCo a faithful judge of a friction plan (README,
   (``OPTIONS``): a sticking contact does not creep, torsion included;
 - the task wrench of a chosen load case enters through an integrator actuator on the part's free
   joint: its activation grows at ``1 / ramp`` per second up to ``max_multiple``, so the load is a
-  ramp ``k(t) W``; keyframe ``"plan"`` holds the controls and the starting pose.
+  ramp ``k(t) W`` from a starting multiple; keyframe ``"plan"`` holds the controls, that
+  multiple and the starting pose.
 
 The free joint's rotational degrees of freedom act in the part's frame, aligned with the world
 at the start; over the small motions of a slip test the task moment stays within that rotation
@@ -89,10 +90,11 @@ def to_mjcf(
     scale: float = 1.0,
     ramp: float = 1.0,
     max_multiple: float = 2.0,
+    start: float = 0.0,
 ) -> Scene:
     """The MuJoCo scene of ``problem`` with its active forces times ``scale``, and the task load
-    of case ``load`` (default the first) ramped from 0 at ``1 / ramp`` per second [1/s] up to
-    ``max_multiple``.
+    of case ``load`` (default the first) ramped from ``start`` at ``1 / ramp`` per second [1/s]
+    up to ``max_multiple`` (start at the lower end of a held interval that does not reach 0).
 
     The active forces [N] are ``forces`` (by contact name) where given, else the plan's for that
     case, else the contacts' own ``force``.
@@ -109,6 +111,8 @@ def to_mjcf(
     for key, value in (("scale", scale), ("ramp", ramp), ("max_multiple", max_multiple)):
         if not np.isfinite(value) or value <= 0.0:
             raise InvalidArgumentError(f"{key} must be a positive number, got {value!r}")
+    if not 0.0 <= start <= max_multiple:
+        raise InvalidArgumentError(f"start must be from 0 to max_multiple, got {start!r}")
     active = [c.name for c in problem.contacts if c.is_active]
     for name, value in (forces or {}).items():
         if name not in active:
@@ -151,7 +155,7 @@ def to_mjcf(
         f'gear="{_numbers(task_about_center)}"/>',
         "  </actuator>",
         "  <keyframe>",
-        f'    <key name="plan" ctrl="{_controls(problem, forces, ramp)}"/>',
+        f'    <key name="plan" ctrl="{_controls(problem, forces, ramp)}" act="{start:.9g}"/>',
         "  </keyframe>",
         "</mujoco>",
     ]

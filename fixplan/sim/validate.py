@@ -1,0 +1,191 @@
+"""MuJoCo as the independent judge of a plan: held or slipped, in which motion, at what load.
+
+For each load case the plan's scene (:func:`~fixplan.sim.mjcf.to_mjcf`) is simulated three
+times:
+
+- with the active forces scaled up by the margin, the task load ramped to 1× and held: the plan
+  says *held*, so the part must not move (``HELD_DISPLACEMENT``, ``HELD_ROTATION``);
+- scaled down by the margin: a case on its limit (a least-force plan's critical case) must slip;
+  the part's twist when it starts to slide is compared with the plan's impending motion;
+- at the planned forces with the task load ramped past the plan's safety factor: the multiple at
+  which the part starts to slide (its speed passes ``SLIP_SPEED``) against the safety factor.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from fixplan.errors import InvalidArgumentError
+from fixplan.planner.problem import Problem
+from fixplan.sim.mjcf import to_mjcf
+
+#: Held: the part moved less than this [m] over the whole run ...
+HELD_DISPLACEMENT = 1e-3
+#: ... and turned less than this [rad].
+HELD_ROTATION = 1e-2
+#: The part slides once a point at the length scale from its centre moves faster than this [m/s]
+#: (after ``SETTLE`` seconds, in which the soft contacts take up the forces).
+SLIP_SPEED = 5e-4
+SETTLE = 0.1
+#: Seconds for the task load to reach 1× in the held and slip runs, and seconds held after that.
+RAMP, HOLD = 1.0, 0.5
+#: Seconds for the onset run's ramp from 0 to ``ONSET_REACH`` times the safety factor.
+ONSET_RAMP, ONSET_REACH = 2.0, 1.5
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Run:
+    """One simulation: the part's displacement [m] and rotation [rad] at the end, and where it
+    started to slide (``None`` if it never did): the task-load multiple then and its twist
+    ``(v at the world origin [m/s], ω [rad/s])``."""
+
+    displacement: float
+    rotation: float
+    onset_multiple: float | None
+    onset_twist: np.ndarray | None
+
+    @property
+    def held(self) -> bool:
+        return self.displacement < HELD_DISPLACEMENT and self.rotation < HELD_ROTATION
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class CaseValidation:
+    """What MuJoCo says about one load case of a plan.
+
+    Attributes
+    ----------
+    load : str
+        The load case.
+    planned_held, safety_factor : bool, float
+        What the plan says.
+    above, below : Run
+        The runs with the active forces scaled by ``1 + margin`` and ``1 - margin``.
+    onset : Run or None
+        The run at the planned forces with the load ramped past the safety factor (``None``
+        where the safety factor is infinite).
+    motion_angle : float or None
+        Angle [rad] between the simulated twist at slip onset (of the onset run, else the
+        ``below`` run) and the plan's impending motion, both as ``(v, L ω)`` with the plan's length
+        scale ``L``; ``None`` where the part did not slide or the plan has no motion.
+    """
+
+    load: str
+    planned_held: bool
+    safety_factor: float
+    above: Run
+    below: Run
+    onset: Run | None
+    motion_angle: float | None
+
+    @property
+    def contradicts(self) -> bool:
+        """Whether the plan calls the case held and the simulation lets it slip."""
+        return self.planned_held and not self.above.held
+
+    @property
+    def onset_ratio(self) -> float | None:
+        """Simulated slip-onset multiple over the plan's safety factor."""
+        if self.onset is None or self.onset.onset_multiple is None:
+            return None
+        return self.onset.onset_multiple / self.safety_factor
+
+
+def validate(
+    problem: Problem,
+    plan,
+    *,
+    margin: float = 0.1,
+    loads: list[str] | None = None,
+    length_scale: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> list[CaseValidation]:
+    """Simulate every load case of ``plan`` (or those named in ``loads``) in MuJoCo."""
+    if not 0.0 < margin < 1.0:
+        raise InvalidArgumentError(f"margin must be between 0 and 1, got {margin!r}")
+    if plan.status != "optimal" or plan.forces is None:
+        raise InvalidArgumentError(
+            f"only an optimal plan can be simulated; this one is {plan.status}"
+        )
+    names = list(plan.load_names) if loads is None else list(loads)
+    unknown = [name for name in names if name not in plan.load_names]
+    if unknown:
+        raise InvalidArgumentError(
+            f"unknown load case {unknown[0]!r}; the plan's are {', '.join(map(repr, plan.load_names))}"
+        )
+    scale = _length_scale(problem) if length_scale is None else length_scale
+    found = []
+    for done, name in enumerate(names):
+        safety = float(plan.safety_factors[name])
+        lowest = min(float(plan.held_intervals[name][0]), 1.0)  # where the ramps start
+        runs = {}
+        for key, factor in (("above", 1 + margin), ("below", 1 - margin)):
+            ramp = RAMP / (1.0 - lowest) if lowest < 1.0 else RAMP
+            scene = to_mjcf(problem, plan, load=name, scale=factor, ramp=ramp, max_multiple=1.0,
+                            start=lowest)  # fmt: skip
+            runs[key] = simulate(scene, RAMP + HOLD, problem, scale)
+        above, below = runs["above"], runs["below"]
+        onset = None
+        if np.isfinite(safety):
+            reach = ONSET_REACH * safety
+            scene = to_mjcf(problem, plan, load=name, ramp=ONSET_RAMP / (reach - lowest),
+                            max_multiple=reach, start=lowest)  # fmt: skip
+            onset = simulate(scene, ONSET_RAMP, problem, scale)
+        motion = plan.motions.get(name) if plan.motions else None
+        # The plan's motion is that at the top of the held interval: the onset run's slide.
+        twist = onset.onset_twist if onset is not None else None
+        twist = below.onset_twist if twist is None else twist
+        angle = None if motion is None or twist is None else _angle(twist, motion.twist, scale)
+        found.append(CaseValidation(load=name, planned_held=bool(plan.held[name]),
+                                    safety_factor=safety, above=above, below=below, onset=onset,
+                                    motion_angle=angle))  # fmt: skip
+        if progress is not None:
+            progress(done + 1, len(names))
+    return found
+
+
+def simulate(scene, seconds: float, problem: Problem, length_scale: float) -> Run:
+    """Run ``scene`` from its keyframe for ``seconds``; watch for the onset of sliding."""
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_string(scene.xml)
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, 0)
+    start, turn = data.qpos[:3].copy(), data.qpos[3:7].copy()
+    onset_multiple, onset_twist = None, None
+    settle = round(SETTLE / model.opt.timestep)
+    for step in range(round(seconds / model.opt.timestep)):
+        mujoco.mj_step(model, data)
+        if onset_multiple is None and step >= settle:
+            twist = _twist(data)
+            if np.linalg.norm(twist[:3]) + length_scale * np.linalg.norm(twist[3:]) > SLIP_SPEED:
+                onset_multiple, onset_twist = float(data.act[-1]), twist
+    rotation = 2.0 * np.arccos(min(1.0, abs(float(data.qpos[3:7] @ turn))))
+    return Run(displacement=float(np.linalg.norm(data.qpos[:3] - start)), rotation=rotation,
+               onset_multiple=onset_multiple, onset_twist=onset_twist)  # fmt: skip
+
+
+def _twist(data) -> np.ndarray:
+    """The part's twist: velocity of the body point at the world origin and angular velocity,
+    world frame (the free joint's angular velocity is in the part's frame)."""
+    import mujoco
+
+    rotation = np.zeros(9)
+    mujoco.mju_quat2Mat(rotation, data.qpos[3:7])
+    omega = rotation.reshape(3, 3) @ data.qvel[3:6]
+    return np.r_[data.qvel[:3] - np.cross(omega, data.qpos[:3]), omega]
+
+
+def _angle(simulated: np.ndarray, planned: np.ndarray, length_scale: float) -> float:
+    weights = np.r_[np.ones(3), np.full(3, length_scale)]
+    a, b = simulated * weights, np.asarray(planned, dtype=float) * weights
+    cosine = float(a @ b / (np.linalg.norm(a) * np.linalg.norm(b)))
+    return float(np.arccos(np.clip(cosine, -1.0, 1.0)))
+
+
+def _length_scale(problem: Problem) -> float:
+    spread = [np.linalg.norm(c.position - problem.body.center_of_mass) for c in problem.contacts]
+    return float(max(max(spread), 1e-3))
