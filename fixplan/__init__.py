@@ -10,6 +10,7 @@ from measurements (:mod:`fixplan.motion`).
 The package is layered; each subpackage imports only from those below it::
 
     io/        problem, push and measurement files, reports, figures, command line
+    design/    layout search over candidate contacts (``fixplan.layout``)
     motion/    pushing, pivoting, sliding dynamics, fits and slip-onset updates of limit surfaces
     planner/   problems -> stacked convex problem -> verified plans, motions, certificates
     models/    friction models (ellipsoid family, cones, pyramids, exact) and compare
@@ -53,6 +54,7 @@ _EXPORTS = {
 }
 _MODULES = {
     "compare": "fixplan.models.compare",
+    "layout": "fixplan.design.api",
     "models": "fixplan.models",
     "motion": "fixplan.motion",
     "pressure": "fixplan.surface.pressure",
@@ -77,6 +79,7 @@ __all__ = [
     "Screw",
     "__version__",
     "compare",
+    "layout",
     "load_problem",
     "models",
     "motion",

@@ -216,6 +216,20 @@ def _build_parser() -> argparse.ArgumentParser:
     )  # fmt: skip
     fit.add_argument("--save", type=Path, metavar="FIT.json", help="write the fit as JSON")
     fit.add_argument("--report", type=Path, metavar="DIR", help="write a report folder")
+
+    layout = _subcommand(
+        commands, "layout", "choose the best contacts among candidates (a layout file)",
+        "fixplan layout problems/layouts/layout-plate.toml --top 3 --report out/",
+        _run_layout,
+    )  # fmt: skip
+    layout.add_argument(
+        "file", type=Path, help="layout file: a problem file with [[candidates]] and [choose]"
+    )
+    layout.add_argument("--top", type=int, default=5, help="layouts printed (default 5)")
+    layout.add_argument("--mode", choices=("auto", "exact", "large"), default="auto",
+                        help="exact enumeration, large-problem heuristic, or auto (default)")  # fmt: skip
+    layout.add_argument("--report", type=Path, metavar="DIR", help="write a report folder")
+    _objective_option(layout)
     return parser
 
 
@@ -259,6 +273,62 @@ class _Progress:
 
 
 # -- plan ----------------------------------------------------------------------------------------
+
+
+def _run_layout(args: argparse.Namespace) -> tuple[int, str]:
+    from fixplan.design.layout import LayoutSearch
+    from fixplan.io.problem_file import load_problem
+
+    if args.top < 1:
+        raise InvalidArgumentError(f"--top must be a positive integer, got {args.top}")
+    problem_file = load_problem(args.file, objective=args.objective, layout=True)
+    if args.report is not None:
+        _check_output_folder(args.report, "--report")
+    try:
+        search = LayoutSearch(
+            problem_file.problem, problem_file.candidates, choose=problem_file.choose
+        )
+    except InvalidArgumentError as exc:
+        raise InvalidArgumentError(f"{args.file}: {exc}") from None
+    layouts = search.run(top=args.top, mode=args.mode)
+    stats = search.stats
+    if args.report is not None:
+        from fixplan.io.layout_report import write_layout_report
+
+        written = write_layout_report(args.report, problem_file, layouts, stats)
+        log.info("wrote %d report files to %s", len(written), args.report)
+    code = EXIT_OK if layouts else EXIT_NOT_HELD
+    if args.json:
+        document = {
+            "problem": {"name": problem_file.name, "file": str(problem_file.path),
+                        "sha256": problem_file.sha256},
+            "search": dataclasses.asdict(stats),
+            "layouts": [
+                {"contacts": list(layout.contacts), "objective_value": layout.objective_value,
+                 "equivalents": [list(e) for e in layout.equivalents],
+                 "plan": layout.plan.as_dict()}
+                for layout in layouts
+            ],
+        }  # fmt: skip
+        return code, _json(document)
+    fixed = len(problem_file.problem.contacts) - len(problem_file.candidates)
+    lines = [
+        f"layouts    {problem_file.name} ({problem_file.kind}), {len(problem_file.candidates)} "
+        f"candidates, {fixed} fixed contacts, {len(problem_file.problem.loads)} load cases",
+        f"objective  {problem_file.problem.objective}",
+        f"search     {stats.mode}: {stats.layouts} layouts, {stats.invalid} invalid, "
+        f"{stats.pruned} pruned, {stats.merged} merged by {stats.symmetries - 1} symmetries, "
+        f"{stats.solved} solved ({stats.feasible} held), {stats.seconds:.2f} s",
+    ]
+    if not layouts:
+        lines.append("no layout of the candidates holds every load case")
+    for rank, layout in enumerate(layouts, start=1):
+        twins = f"  (+{len(layout.equivalents)} symmetric)" if layout.equivalents else ""
+        lines.append(
+            f"  {rank:2d}  {_number(layout.objective_value):>12s}  {', '.join(layout.contacts)}"
+            f"{twins}"
+        )
+    return code, "\n".join(lines)
 
 
 def _exit_code(plan) -> int:

@@ -90,6 +90,25 @@ Patch shapes (lengths [m], coordinates in the contact's patch frame):
 - ``points``: ``xy = [[x, y], ...]``, optional relative ``weights``;
 - ``grid``: cell centres ``x``, ``y`` and relative pressures ``values``, one row per ``y``:
   an array of rows or the name of a CSV file, relative to the problem file's folder.
+
+A **layout file** (``fixplan layout``, :func:`load_problem` with ``layout=True``) is a problem
+file whose ``[[contacts]]`` (now optional) are the fixed contacts, plus candidate contacts and how
+many of each role a layout uses::
+
+    [[candidates]]                        # at least one; the keys of [[contacts]]
+    name = "rest-a"
+    role = "locator"
+    position = [-0.055, -0.035, 0.0]
+    normal = [0.0, 0.0, 1.0]
+
+    [[candidates]]                        # or candidates spread over faces of the body's mesh:
+    name = "top"                          # named top-0, top-1, ... (no position or normal)
+    role = "clamp"
+    sample = { facing = [0.0, 0.0, 1.0], count = 12, seed = 0 }   # or faces = [indices]
+
+    [choose]                              # role -> a count or [min, max]
+    locator = 3
+    clamp = [1, 2]
 """
 
 from __future__ import annotations
@@ -198,6 +217,10 @@ _TOP_KEYS = (
     "contacts",
     "loads",
 )
+_LAYOUT_KEYS = ("candidates", "choose")
+_SAMPLE_KEYS = ("count", "facing", "faces", "seed")
+#: Most candidates one ``sample`` table may spread over a mesh.
+MAX_SAMPLED = 10_000
 _DEFAULT_KEYS = ("mu", "model", "facets", "inscribed", "stiffness")
 _CONTACT_KEYS = (
     "name",
@@ -254,6 +277,10 @@ class ProblemFile:
         (their own or ``[defaults]``'); ``None`` when it gives none.
     surface_contacts : dict
         :class:`SurfaceContact` by contact name, for the contacts placed with ``on_surface``.
+    candidates : tuple of Contact
+        A layout file's candidate contacts (also the last contacts of ``problem``).
+    choose : dict
+        A layout file's role -> count or ``(min, max)``.
     """
 
     problem: Problem
@@ -264,10 +291,16 @@ class ProblemFile:
     model_override: str | None = None
     stiffness: dict[str, Stiffness] | None = None
     surface_contacts: dict[str, SurfaceContact] = field(default_factory=dict)
+    candidates: tuple[Contact, ...] = ()
+    choose: dict = field(default_factory=dict)
 
 
 def load_problem(
-    path: str | os.PathLike[str], *, model: str | None = None, objective: str | None = None
+    path: str | os.PathLike[str],
+    *,
+    model: str | None = None,
+    objective: str | None = None,
+    layout: bool = False,
 ) -> ProblemFile:
     """Read and validate a TOML problem file (schema in the module docstring).
 
@@ -283,6 +316,9 @@ def load_problem(
     objective : str, optional
         Objective that replaces the file's (one of :data:`fixplan.planner.problem.OBJECTIVES`);
         its demands on the contacts (given forces, stiffnesses) are checked as the file's.
+    layout : bool, optional
+        Read a layout file: ``[[candidates]]`` and ``[choose]``, ``[[contacts]]`` optional. The
+        problem's contacts are the fixed ones followed by the candidates.
 
     Returns
     -------
@@ -307,7 +343,7 @@ def load_problem(
         message = f"cannot read the file: {exc}"
         raise ProblemFileError(path, [Issue(key_path="", message=message)]) from None
     document = parse_toml(path, content)
-    reader = _Reader(folder=path.parent, model=model, objective=objective)
+    reader = _Reader(folder=path.parent, model=model, objective=objective, layout=layout)
     name, kind, problem = reader.document(document)
     if reader.issues or problem is None:
         raise ProblemFileError(path, reader.issues)
@@ -320,6 +356,8 @@ def load_problem(
         model_override=model,
         stiffness=reader.stiffness or None,
         surface_contacts=reader.surface_contacts,
+        candidates=tuple(reader.candidates),
+        choose=reader.choose,
     )
 
 
@@ -419,8 +457,13 @@ class _Defaults:
 class _Reader:
     """Reads a parsed problem file, collecting issues; builds only what is valid."""
 
-    def __init__(self, *, folder: Path, model: str | None, objective: str | None):
+    def __init__(
+        self, *, folder: Path, model: str | None, objective: str | None, layout: bool = False
+    ):
         self.folder = folder
+        self.layout = layout
+        self.candidates: list[Contact] = []
+        self.choose: dict = {}
         self.model = model
         self.objective = objective
         self.issues: list[Issue] = []
@@ -433,7 +476,7 @@ class _Reader:
     def document(self, data: dict) -> tuple[str | None, str | None, Problem | None]:
         """The file's name, kind and problem (``None`` where invalid)."""
         top = Table(data, "", self.issues)
-        top.check_keys(_TOP_KEYS)
+        top.check_keys(_TOP_KEYS + (_LAYOUT_KEYS if self.layout else ()))
         check_schema_version(top)
         name = top.get("name", _NAME, required=True)
         if data.get("kind") == "push":
@@ -449,9 +492,14 @@ class _Reader:
         body = self._body(body_table)
         self.mesh = None if body is None else body.mesh
         self.mesh_declared = body_table is not None and "mesh" in body_table.data
-        contact_tables = top.tables("contacts")
+        optional = self.layout and "contacts" not in data
+        contact_tables = [] if optional else top.tables("contacts")
         contacts = [self._contact(table, defaults) for table in contact_tables]
         check_unique_names(contact_tables, "contact")
+        if self.layout:
+            self.candidates = self._candidates(top, defaults, body)
+            contacts += self.candidates
+            self.choose = _choose(top.table("choose", required=True))
         self._stiffnesses(top, contact_tables, defaults, objective)
         load_tables = top.tables("loads")
         loads = [self._load(table) for table in load_tables]
@@ -469,6 +517,51 @@ class _Reader:
             objective=objective,
         )
         return name, kind, problem
+
+    def _candidates(self, top: Table, defaults: _Defaults, body: Body | None) -> list[Contact]:
+        """A layout file's candidates, those of ``sample`` tables spread over the mesh."""
+        tables = top.tables("candidates")
+        check_unique_names(tables, "candidate")
+        found = []
+        for table in tables:
+            if "sample" in table.data:
+                found += self._sampled(table, defaults, body)
+            else:
+                found.append(self._contact(table, defaults))
+        return found
+
+    def _sampled(self, table: Table, defaults: _Defaults, body: Body | None) -> list:
+        """The candidates of a ``sample`` table (:func:`fixplan.design.candidates.sample_surface`)."""
+        from fixplan.design.candidates import sample_surface
+
+        for key in ("position", "normal", "on_surface"):
+            if key in table.data:
+                table.report(key, "not with sample: the mesh gives the candidates' " + key)
+        spec = table.table("sample")
+        if spec is None:
+            return []
+        spec.check_keys(_SAMPLE_KEYS)
+        count = spec.get("count", Integer(1, MAX_SAMPLED), required=True)
+        facing = spec.get("facing", Array((3,), Number("", MAX_LENGTH, "")))
+        faces = spec.get("faces", Array((None,), Number(">= 0", 2**31 - 1)))
+        seed = spec.get("seed", Integer(0, 2**31 - 1), default=0)
+        if self.mesh is None and not self.mesh_declared:
+            table.report("sample", 'needs a body read from a mesh ([body] mesh = "...")')
+        data = {k: v for k, v in table.data.items() if k not in ("sample", "position", "normal")}
+        template = self._contact(
+            Table({**data, "position": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]}, table.path,
+                  self.issues), defaults,
+        )  # fmt: skip
+        if template is None or body is None or self.mesh is None or count is None:
+            return []
+        try:
+            return sample_surface(
+                body, template=template, n=count, faces=faces, facing=facing, seed=seed,
+                prefix=f"{template.name}-",
+            )  # fmt: skip
+        except InvalidArgumentError as exc:
+            table.report("sample", str(exc))
+            return []
 
     def _defaults(self, table: Table | None) -> _Defaults:
         if table is None:
@@ -678,6 +771,32 @@ class _Reader:
             f"missing: {contact} needs a patch (area and pressure) for {source}; add one or use "
             "'point-cone' or 'point-pyramid'",
         )
+
+
+def _choose(table: Table | None) -> dict:
+    """A layout file's ``[choose]``: role -> count or ``(min, max)`` (counts >= 0)."""
+    if table is None:
+        return {}
+    table.check_keys(ROLES)
+    found = {}
+    for role in ROLES:
+        value = table.data.get(role)
+        if value is None:
+            continue
+        if isinstance(value, int) and not isinstance(value, bool) and value >= 0:
+            found[role] = value
+        elif (
+            isinstance(value, list)
+            and len(value) == 2
+            and all(isinstance(x, int) and not isinstance(x, bool) and x >= 0 for x in value)
+            and value[0] <= value[1]
+        ):
+            found[role] = (value[0], value[1])
+        else:
+            table.report(role, f"expected a count >= 0 or [min, max], got {describe(value)}")
+    if not table.data:
+        table.report(None, "expected at least one role, e.g. locator = 3")
+    return found
 
 
 def _stiffness(table: Table) -> Stiffness | None:

@@ -59,9 +59,19 @@ class Planner:
     allow_squeeze : bool, optional
         Let passive contacts squeeze each other, as a rigid model does (default ``False``; see
         :mod:`fixplan.planner.squeeze`: not conservative, for comparison only).
+    switchable : bool, optional
+        Compile a switch per contact, so that :meth:`solve` can leave contacts out
+        (``disabled``) without recompiling: the layouts of :mod:`fixplan.design.layout`.
     """
 
-    def __init__(self, problem: Problem, *, solver: str | None = None, allow_squeeze: bool = False):
+    def __init__(
+        self,
+        problem: Problem,
+        *,
+        solver: str | None = None,
+        allow_squeeze: bool = False,
+        switchable: bool = False,
+    ):
         if not isinstance(problem, Problem):
             raise InvalidArgumentError(f"problem must be a Problem, got {type(problem).__name__}")
         solver = "CLARABEL" if solver is None else str(solver).upper()
@@ -86,7 +96,10 @@ class Planner:
         self.squeeze_contacts = tuple(
             c.name for c, s in zip(problem.contacts, squeezable, strict=True) if s
         )
-        self._runner = Runner(problem, self.layout, solver, squeeze=bool(self.squeeze_contacts))
+        self.switchable = switchable
+        self._runner = Runner(
+            problem, self.layout, solver, squeeze=bool(self.squeeze_contacts), switchable=switchable
+        )
 
     def solve(
         self,
@@ -94,8 +107,13 @@ class Planner:
         *,
         analyse: bool = True,
         progress: Callable[[int, int], None] | None = None,
+        disabled: Sequence[str] = (),
     ) -> Plan:
         """Solve with ``loads`` (default: the problem's); the structure is reused.
+
+        ``disabled`` names contacts left out of this solve (a planner built ``switchable``): they
+        carry no force, and the answer is that of the problem without them (the plan still lists
+        them, with zero forces).
 
         ``loads`` must have the problem's number of load cases. With ``analyse`` (default) a
         force objective is followed by the fixed-force analysis of the forces found (held
@@ -111,11 +129,18 @@ class Planner:
         objective = SOLVED_AS.get(self.problem.objective, self.problem.objective)
         names = tuple(x.name for x in loads)
         wrenches = self.problem.task_wrenches(loads)
-        given = {i: c.force for i, c in enumerate(self.problem.contacts) if c.force is not None}
+        off = self._switched_off(disabled)
+        given = {
+            i: 0.0 if off is not None and off[i] else c.force
+            for i, c in enumerate(self.problem.contacts)
+            if c.force is not None
+        }
         squeezed: dict[str, tuple[str, ...]] = {}
-        result = self._squeeze_free(objective, wrenches, given, squeezed, progress=progress)
+        result = self._squeeze_free(
+            objective, wrenches, given, squeezed, progress=progress, disabled=off
+        )
         if result["status"] == "optimal":
-            result = self._refine(objective, result, wrenches, given, squeezed)
+            result = self._refine(objective, result, wrenches, given, squeezed, off)
         notes = list(result["warnings"])
         fields = {"load_names": names, "squeeze_contacts": self.squeeze_contacts}
         status = result["status"]
@@ -130,9 +155,11 @@ class Planner:
             return self._plan(status, None, result["solver"], start, notes, fields)
         residual, problems = self._verify(result, wrenches)
         if problems and result["solver"].startswith("CLARABEL"):
-            retry = self._squeeze_free(objective, wrenches, given, squeezed, accurate=True)
+            retry = self._squeeze_free(
+                objective, wrenches, given, squeezed, accurate=True, disabled=off
+            )
             if retry["status"] == "optimal":
-                result = self._refine(objective, retry, wrenches, given, squeezed)
+                result = self._refine(objective, retry, wrenches, given, squeezed, off)
                 residual, problems = self._verify(result, wrenches)
         if problems:
             status = "inaccurate"
@@ -141,12 +168,14 @@ class Planner:
                 warnings.warn(note, stacklevel=2)
         forces = self._active_forces(result["normal"])
         if objective in FIXED_FORCE_OBJECTIVES:
-            extra = self._intervals(result, wrenches, given, squeezed, progress)
+            extra = self._intervals(result, wrenches, given, squeezed, progress, off)
         elif analyse and status == "optimal":
             planned = {i: f for i, f in self._indexed(forces)}
-            checked = self._squeeze_free("check", wrenches, planned, squeezed, progress=progress)
+            checked = self._squeeze_free(
+                "check", wrenches, planned, squeezed, progress=progress, disabled=off
+            )
             if checked["status"] in ("optimal", "inaccurate"):
-                extra = self._intervals(checked, wrenches, planned, squeezed, progress)
+                extra = self._intervals(checked, wrenches, planned, squeezed, progress, off)
             else:
                 notes.append(f"safety analysis of the forces found: {checked['status']}")
                 extra = {}
@@ -165,14 +194,37 @@ class Planner:
 
     # -- stages -------------------------------------------------------------------------------
 
+    def _switched_off(self, disabled: Sequence[str]) -> np.ndarray | None:
+        """``(C,)`` bool of the contacts named in ``disabled`` (``None`` for none)."""
+        names = [c.name for c in self.problem.contacts]
+        disabled = tuple(disabled)
+        if not disabled:
+            return None
+        if not self.switchable:
+            raise InvalidArgumentError("disabled needs a planner built with switchable=True")
+        unknown = sorted(set(disabled) - set(names))
+        if unknown:
+            raise InvalidArgumentError(f"disabled names unknown contacts: {', '.join(unknown)}")
+        return np.isin(names, disabled)
+
     def _squeeze_free(
-        self, objective, wrenches, given, squeezed, *, sense=1.0, accurate=False, progress=None
+        self,
+        objective,
+        wrenches,
+        given,
+        squeezed,
+        *,
+        sense=1.0,
+        accurate=False,
+        progress=None,
+        disabled=None,
     ):
         """Solve ``objective``, unloading passive contacts until no case holds a squeeze.
 
-        ``squeezed`` collects, per load case name, the contacts unloaded (for the notes).
+        ``squeezed`` collects, per load case name, the contacts unloaded (for the notes);
+        ``disabled`` ``(C,)`` bool marks the contacts switched off.
         """
-        options = {"sense": sense, "accurate": accurate, "progress": progress}
+        options = {"sense": sense, "accurate": accurate, "progress": progress, "disabled": disabled}
         result = self._runner.run(objective, wrenches, given, **options)
         if not self.squeeze_contacts:
             return result
@@ -193,7 +245,7 @@ class Planner:
                 squeezed[name] = tuple(dict.fromkeys(squeezed.get(name, ()) + found))
         return result
 
-    def _refine(self, objective, result, wrenches, given, squeezed) -> dict:
+    def _refine(self, objective, result, wrenches, given, squeezed, disabled=None) -> dict:
         """Second stage of a force objective whose free clamps couple the load cases.
 
         The first stage leaves the fingers of the non-critical cases anywhere below the
@@ -207,13 +259,15 @@ class Planner:
             return result
         fixed = dict(given)
         fixed.update({i: float(result["normal"][i, 0]) for i in free_clamps})
-        refined = self._squeeze_free(objective + REFINE, wrenches, fixed, squeezed)
+        refined = self._squeeze_free(
+            objective + REFINE, wrenches, fixed, squeezed, disabled=disabled
+        )
         return refined if refined["status"] == "optimal" else result
 
-    def _intervals(self, highest, wrenches, given, squeezed, progress) -> dict:
+    def _intervals(self, highest, wrenches, given, squeezed, progress, disabled=None) -> dict:
         """Held intervals, motions and utilisation of the given forces (``highest``: the
         maximising fixed-force solve)."""
-        lowest = self._lowest(wrenches, given, squeezed, progress)
+        lowest = self._lowest(wrenches, given, squeezed, progress, disabled)
         if lowest["status"] not in ("optimal", "inaccurate"):
             lowest = None
         decided = self._passive.copy()
@@ -222,7 +276,7 @@ class Planner:
             self.length_scale,
         )  # fmt: skip
 
-    def _lowest(self, wrenches, given, squeezed, progress) -> dict:
+    def _lowest(self, wrenches, given, squeezed, progress, disabled=None) -> dict:
         """The minimising fixed-force solve: ``scale`` holds ``k_min`` of every case.
 
         At ``k = 0`` the task load drops out, so whether a case is held without it depends only
@@ -234,8 +288,9 @@ class Planner:
         def minimised(index, report=None):
             values = {i: v if np.ndim(v) == 0 else np.asarray(v)[index] for i, v in given.items()}
             return self._squeeze_free(
-                "check", wrenches[:, index], values, squeezed, sense=-1.0, progress=report
-            )
+                "check", wrenches[:, index], values, squeezed, sense=-1.0, progress=report,
+                disabled=disabled,
+            )  # fmt: skip
 
         cases = wrenches.shape[1]
         if self.squeeze_contacts or not given:

@@ -75,11 +75,20 @@ class Runner:
     equilibrium multipliers: the twist of impending motion per case).
     """
 
-    def __init__(self, problem: Problem, layout: ContactLayout, solver: str, *, squeeze: bool):
+    def __init__(
+        self,
+        problem: Problem,
+        layout: ContactLayout,
+        solver: str,
+        *,
+        squeeze: bool,
+        switchable: bool = False,
+    ):
         self.problem = problem
         self.layout = layout
         self.solver = solver
         self.squeeze = squeeze
+        self.switchable = switchable
         self._built: dict[str, Stacked] = {}
         self._direct: dict[str, DirectSolver | None] = {}
         self._solves: dict[str, int] = {}
@@ -94,7 +103,7 @@ class Runner:
         if objective not in self._built:
             self._built[objective] = build(
                 self.problem, self.layout, objective, self.block_size(objective),
-                squeeze=self.squeeze,
+                squeeze=self.squeeze, switchable=self.switchable,
             )  # fmt: skip
         return self._built[objective]
 
@@ -108,6 +117,7 @@ class Runner:
         unloaded: np.ndarray | None = None,
         accurate: bool = False,
         progress=None,
+        disabled: np.ndarray | None = None,
     ) -> dict:
         """Solve all load cases (task ``wrenches`` ``(6, K)``), block by block.
 
@@ -115,12 +125,15 @@ class Runner:
         ``sense`` -1 minimises the task-load multiples instead of maximising them;
         ``unloaded`` ``(passive, K)`` marks passive contacts held without normal force;
         ``accurate`` turns Clarabel's iterative refinement on (for a retry when an answer failed
-        verification). The last block is padded with copies of its first case.
+        verification); ``disabled`` ``(C,)`` bool switches contacts off (a runner built
+        ``switchable``). The last block is padded with copies of its first case.
         """
         cases = wrenches.shape[1]
         block = self.block_size(objective)
         if cases == block:  # one block, no padding (re-solves in a control loop)
-            result = self._run_block(objective, wrenches, given, sense, unloaded, accurate)
+            result = self._run_block(
+                objective, wrenches, given, sense, unloaded, accurate, disabled
+            )
             if progress is not None:
                 progress(cases, cases)
             return result
@@ -133,13 +146,17 @@ class Runner:
                 for i, v in given.items()
             }
             mask = None if unloaded is None else unloaded[:, padded]
-            result = self._run_block(objective, wrenches[:, padded], values, sense, mask, accurate)
+            result = self._run_block(
+                objective, wrenches[:, padded], values, sense, mask, accurate, disabled
+            )
             results.append((result, len(index)))
             if progress is not None:
                 progress(int(index[-1]) + 1, cases)
         return _merge(results)
 
-    def _run_block(self, objective, wrenches, given, sense, unloaded, accurate) -> dict:
+    def _run_block(
+        self, objective, wrenches, given, sense, unloaded, accurate, disabled=None
+    ) -> dict:
         stacked = self.stacked(objective)
         assign(stacked.task, wrenches)
         assign(stacked.gravity, self.problem.body.weight_wrench)
@@ -148,6 +165,8 @@ class Runner:
             assign(stacked.sense, float(sense))
         if stacked.unloaded is not None:
             assign(stacked.unloaded, 0.0 if unloaded is None else unloaded.astype(float))
+        if stacked.disabled is not None:
+            assign(stacked.disabled, 0.0 if disabled is None else disabled.astype(float))
         cuts = stacked.cuts is not None  # rounds of cuts follow every solve
         direct = None if accurate or cuts else self._direct_result(objective, stacked)
         if direct is not None:

@@ -152,6 +152,9 @@ class Stacked:
         contact whose force is free in this objective).
     cuts : CutPool or None
         The tangent-plane cuts of the exact contacts (``None`` without exact models).
+    disabled : cvxpy.Parameter or None
+        ``(C,)``: 1 where a contact is switched off (its normal force held at 0, so its friction
+        load too), for layouts that use some of the contacts (``switchable`` in :func:`build`).
     """
 
     problem: cp.Problem
@@ -169,15 +172,24 @@ class Stacked:
     balance: cp.Constraint
     decided: np.ndarray
     cuts: CutPool | None
+    disabled: cp.Parameter | None = None
 
 
 def build(
-    problem: Problem, layout: ContactLayout, objective: str, cases: int, *, squeeze: bool
+    problem: Problem,
+    layout: ContactLayout,
+    objective: str,
+    cases: int,
+    *,
+    squeeze: bool,
+    switchable: bool = False,
 ) -> Stacked:
     """The stacked problem of ``objective`` (``objective + REFINE``: its second stage, with the
     clamp forces given) over ``cases`` load cases.
 
-    ``squeeze`` adds the ``unloaded`` Parameter (see :mod:`fixplan.planner.squeeze`).
+    ``squeeze`` adds the ``unloaded`` Parameter (see :mod:`fixplan.planner.squeeze`);
+    ``switchable`` the ``disabled`` one, ``disabled_i * n_ij == 0`` on the decided normal forces
+    (DPP; a given force of a disabled contact is set to 0 by its caller).
     """
     contacts = problem.contacts
     scaling = objective in FIXED_FORCE_OBJECTIVES
@@ -265,6 +277,15 @@ def build(
         unloaded = cp.Parameter((len(groups["passive"]), cases), nonneg=True, name="unloaded")
         unloaded.value = np.zeros(unloaded.shape)
         constraints.append(cp.multiply(unloaded, pieces["passive"]) == 0)
+    disabled = None
+    if switchable:
+        disabled = cp.Parameter(count, nonneg=True, name="disabled", value=np.zeros(count))
+        for key in ("passive", "finger", "clamp"):
+            if groups[key]:
+                switch = disabled[np.asarray(groups[key])]
+                if key != "clamp":
+                    switch = cp.reshape(switch, (len(groups[key]), 1), order="F") @ ones
+                constraints.append(cp.multiply(switch, pieces[key]) == 0)
 
     free_index = groups["finger"] + groups["clamp"]
     goal = objective_expression(
@@ -298,6 +319,7 @@ def build(
         balance=balance,
         decided=decided,
         cuts=cuts,
+        disabled=disabled,
     )
 
 

@@ -1,0 +1,1 @@
+"""Design: layout search and parameter sweeps, built on the planner."""
