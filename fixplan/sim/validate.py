@@ -22,14 +22,17 @@ from fixplan.errors import InvalidArgumentError
 from fixplan.planner.problem import Problem
 from fixplan.sim.mjcf import to_mjcf
 
-#: Held: the part moved less than this [m] over the whole run ...
+#: Held: no contact slipped by more than this [m] over the whole run ...
 HELD_DISPLACEMENT = 1e-3
 #: ... and turned less than this [rad].
 HELD_ROTATION = 1e-2
-#: The part slides once a point at the length scale from its centre moves faster than this [m/s]
-#: (after ``SETTLE`` seconds, in which the soft contacts take up the forces).
-SLIP_SPEED = 5e-4
+#: The part slides once a contact slips faster than this [m/s] (tangential speed of its tip
+#: against its pad plus spin about its normal times its radius), after ``SETTLE`` seconds in
+#: which the soft contacts take up the forces.
+SLIP_SPEED = 1e-4
 SETTLE = 0.1
+#: Steps between two samples of a run's history (10 ms at the scene's 0.5 ms step).
+HISTORY_STRIDE = 20
 #: Seconds for the task load to reach 1× in the held and slip runs, and seconds held after that.
 RAMP, HOLD = 1.0, 0.5
 #: Seconds for the onset run's ramp from 0 to ``ONSET_REACH`` times the safety factor.
@@ -38,14 +41,16 @@ ONSET_RAMP, ONSET_REACH = 2.0, 1.5
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Run:
-    """One simulation: the part's displacement [m] and rotation [rad] at the end, and where it
-    started to slide (``None`` if it never did): the task-load multiple then and its twist
-    ``(v at the world origin [m/s], ω [rad/s])``."""
+    """One simulation: the largest slip at a contact [m] and the part's rotation [rad] at the
+    end, and where it started to slide (``None`` if it never did): the task-load multiple then
+    and the part's twist ``(v at the world origin [m/s], ω [rad/s])``."""
 
     displacement: float
     rotation: float
     onset_multiple: float | None
     onset_twist: np.ndarray | None
+    #: ``(samples, 4)``: time [s], largest slip at a contact [m], rotation [rad], task multiple.
+    history: np.ndarray
 
     @property
     def held(self) -> bool:
@@ -103,7 +108,9 @@ def validate(
     length_scale: float | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> list[CaseValidation]:
-    """Simulate every load case of ``plan`` (or those named in ``loads``) in MuJoCo."""
+    """Simulate every load case of ``plan`` (or those named in ``loads``) in MuJoCo;
+    ``length_scale`` [m] weighs rotation against translation in the motion angle (default: the
+    largest distance of a contact from the centre of mass)."""
     if not 0.0 < margin < 1.0:
         raise InvalidArgumentError(f"margin must be between 0 and 1, got {margin!r}")
     if plan.status != "optimal" or plan.forces is None:
@@ -148,24 +155,57 @@ def validate(
 
 
 def simulate(scene, seconds: float, problem: Problem, length_scale: float) -> Run:
-    """Run ``scene`` from its keyframe for ``seconds``; watch for the onset of sliding."""
+    """Run ``scene`` from its keyframe for ``seconds``; watch for the onset of sliding.
+
+    Sliding is measured at the contacts, between the part and what presses on it: the tangential
+    displacement of each contact's tip relative to its pad on the part (a finger may follow the
+    part along its normal, which is no slip), and the part's rotation.
+    """
     import mujoco
 
     model = mujoco.MjModel.from_xml_string(scene.xml)
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, 0)
-    start, turn = data.qpos[:3].copy(), data.qpos[3:7].copy()
+    mujoco.mj_forward(model, data)
+    part = model.body("part").id
+    tips = [model.geom(f"tip-{c.name}").id for c in problem.contacts]
+    pads = [model.geom(f"pad-{c.name}").id for c in problem.contacts]
+    normals = np.array([c.normal for c in problem.contacts])  # in the part's frame at the start
+    radii = np.array([model.geom_size[pad][0] for pad in pads])
+    turn = data.qpos[3:7].copy()
+
+    def offsets() -> np.ndarray:
+        """Each tip's position relative to its pad, in the part's frame, tangential part."""
+        rotation = data.xmat[part].reshape(3, 3)
+        relative = (data.geom_xpos[tips] - data.geom_xpos[pads]) @ rotation
+        return relative - np.sum(relative * normals, axis=1)[:, None] * normals
+
+    start = previous = offsets()
     onset_multiple, onset_twist = None, None
-    settle = round(SETTLE / model.opt.timestep)
-    for step in range(round(seconds / model.opt.timestep)):
+    history = []
+    settle, step_time = round(SETTLE / model.opt.timestep), model.opt.timestep
+    for step in range(round(seconds / step_time)):
         mujoco.mj_step(model, data)
-        if onset_multiple is None and step >= settle:
+        if onset_multiple is None:
+            now = offsets()
+            sliding = np.linalg.norm(now - previous, axis=1) / step_time
+            previous = now
             twist = _twist(data)
-            if np.linalg.norm(twist[:3]) + length_scale * np.linalg.norm(twist[3:]) > SLIP_SPEED:
+            spinning = np.abs(normals @ (data.xmat[part].reshape(3, 3).T @ twist[3:])) * radii
+            if step >= settle and np.max(sliding + spinning) > SLIP_SPEED:
                 onset_multiple, onset_twist = float(data.act[-1]), twist
-    rotation = 2.0 * np.arccos(min(1.0, abs(float(data.qpos[3:7] @ turn))))
-    return Run(displacement=float(np.linalg.norm(data.qpos[:3] - start)), rotation=rotation,
-               onset_multiple=onset_multiple, onset_twist=onset_twist)  # fmt: skip
+        if step % HISTORY_STRIDE == 0:
+            slip = float(np.max(np.linalg.norm(offsets() - start, axis=1)))
+            history.append((data.time, slip, _rotation(data, turn), float(data.act[-1])))
+    slip = float(np.max(np.linalg.norm(offsets() - start, axis=1)))
+    history.append((data.time, slip, _rotation(data, turn), float(data.act[-1])))
+    return Run(displacement=slip, rotation=_rotation(data, turn), onset_multiple=onset_multiple,
+               onset_twist=onset_twist, history=np.array(history))  # fmt: skip
+
+
+def _rotation(data, start: np.ndarray) -> float:
+    """Angle [rad] the part turned since its orientation ``start`` (a quaternion)."""
+    return 2.0 * np.arccos(min(1.0, abs(float(data.qpos[3:7] @ start))))
 
 
 def _twist(data) -> np.ndarray:

@@ -1,0 +1,48 @@
+"""MuJoCo judges plans: the issue's checks of a soft pinch and of point contacts."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fixplan.errors import InvalidArgumentError
+from fixplan.io.problem_file import load_problem
+from fixplan.planner.planner import Planner
+from fixplan.sim.validate import validate
+
+PROBLEMS = Path(__file__).resolve().parents[1] / "problems"
+
+
+def _planned(name):
+    problem = load_problem(PROBLEMS / f"{name}.toml").problem
+    return problem, Planner(problem).solve()
+
+
+def test_a_soft_pinch_holds_at_110_percent_slips_at_90_onset_and_direction_as_planned():
+    """Hertz fingertips, ellipsoid model (condim 4), a weight off the grasp axis: slip onset
+    within 2 % of the planned load and the slip twist within 2° of the plan's motion."""
+    problem, plan = _planned("hertz-pinch")
+    (case,) = validate(problem, plan, loads=["lift-accelerating"])
+    assert case.planned_held and case.above.held and not case.below.held
+    assert case.onset_ratio == pytest.approx(1.0, abs=0.02)
+    assert np.degrees(case.motion_angle) < 2.0
+    assert not case.contradicts
+    times, slips = case.below.history[:, 0], case.below.history[:, 1]
+    assert np.all(np.diff(times) > 0) and slips[-1] == pytest.approx(case.below.displacement)
+
+
+def test_point_contacts_hold_every_case_at_110_percent_and_the_critical_one_slips_at_90():
+    problem, plan = _planned("point-grasp")
+    cases = {case.load: case for case in validate(problem, plan)}
+    assert all(case.above.held for case in cases.values()), {
+        name: case.above.displacement for name, case in cases.items()
+    }
+    assert not cases[plan.critical_load].below.held
+
+
+def test_bad_requests_are_refused():
+    problem, plan = _planned("hertz-pinch")
+    with pytest.raises(InvalidArgumentError, match="margin"):
+        validate(problem, plan, margin=1.5)
+    with pytest.raises(InvalidArgumentError, match="unknown load case"):
+        validate(problem, plan, loads=["nothing"])
