@@ -1,11 +1,14 @@
 """MuJoCo judges plans: the issue's checks of a soft pinch and of point contacts."""
 
+import json
 from pathlib import Path
 
+import mujoco
 import numpy as np
 import pytest
 
 from fixplan.errors import InvalidArgumentError
+from fixplan.io.cli import EXIT_NOT_HELD, EXIT_OK, main
 from fixplan.io.problem_file import load_problem
 from fixplan.planner.planner import Planner
 from fixplan.sim.validate import validate
@@ -46,3 +49,18 @@ def test_bad_requests_are_refused():
         validate(problem, plan, margin=1.5)
     with pytest.raises(InvalidArgumentError, match="unknown load case"):
         validate(problem, plan, loads=["nothing"])
+
+
+def test_the_command_line_validates_exports_and_reports(tmp_path, capsys):
+    pinch = str(PROBLEMS / "hertz-pinch.toml")
+    code = main(["validate", pinch, "--load", "lift-accelerating", "--json",
+                 "--report", str(tmp_path / "report")])  # fmt: skip
+    assert code == EXIT_OK
+    (case,) = json.loads(capsys.readouterr().out)["cases"]
+    assert case["above"]["held"] and not case["below"]["held"] and not case["contradicts"]
+    assert (tmp_path / "report" / "case-1.png").is_file()
+    scene = tmp_path / "pinch.xml"
+    assert main(["export", pinch, "--mujoco", str(scene), "--load", "insert-tip"]) == EXIT_OK
+    mujoco.MjModel.from_xml_path(str(scene))
+    assert main(["validate", str(PROBLEMS / "unholdable.toml")]) == EXIT_NOT_HELD
+    assert "no forces to simulate" in capsys.readouterr().out

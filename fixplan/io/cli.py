@@ -230,6 +230,32 @@ def _build_parser() -> argparse.ArgumentParser:
                         help="exact enumeration, large-problem heuristic, or auto (default)")  # fmt: skip
     layout.add_argument("--report", type=Path, metavar="DIR", help="write a report folder")
     _objective_option(layout)
+
+    export = _subcommand(
+        commands, "export", "write a problem and its plan as a simulator scene (MuJoCo MJCF)",
+        "fixplan export problems/hertz-pinch.toml --mujoco pinch.xml --load lift-accelerating",
+        _run_export,
+    )  # fmt: skip
+    export.add_argument("file", type=Path, help="problem file (TOML)")
+    export.add_argument("--mujoco", type=Path, required=True, metavar="SCENE.xml",
+                        help="the MJCF scene to write")  # fmt: skip
+    export.add_argument("--load", help="the load case whose task load is ramped (default first)")
+    export.add_argument("--scale", type=float, default=1.0,
+                        help="multiply the planned forces by this (default 1)")  # fmt: skip
+
+    validate = _subcommand(
+        commands, "validate", "simulate a plan in MuJoCo: held at +margin, slips at -margin?",
+        "fixplan validate problems/hertz-pinch.toml --margin 0.1 --report out/",
+        _run_validate,
+    )  # fmt: skip
+    validate.add_argument("file", type=Path, help="problem file (TOML)")
+    validate.add_argument("--engine", choices=("mujoco",), default="mujoco",
+                          help="the physics engine (default mujoco)")  # fmt: skip
+    validate.add_argument("--load", action="append", metavar="NAME",
+                          help="validate this load case only (repeatable; default all)")  # fmt: skip
+    validate.add_argument("--margin", type=float, default=0.1,
+                          help="scale the forces by 1 ± this (default 0.1)")  # fmt: skip
+    validate.add_argument("--report", type=Path, metavar="DIR", help="write a report folder")
     return parser
 
 
@@ -527,6 +553,101 @@ def _surface_lines(problem_file) -> list[str]:
         "the point given"
         for name, p in problem_file.surface_contacts.items()
     ]
+
+
+# -- simulators -----------------------------------------------------------------------------------
+
+
+def _planned(args):
+    """The problem file of ``args.file``, its plan and, if the plan is not optimal, the exit
+    code and message to return (there are no forces to simulate)."""
+    from fixplan.planner.planner import Planner
+
+    problem_file = _load(args.file, None, None)
+    plan = Planner(problem_file.problem).solve()
+    if plan.status == "optimal":
+        return problem_file, plan, None
+    code = EXIT_NOT_HELD if plan.status == "infeasible" else EXIT_SOLVER
+    return (
+        problem_file,
+        plan,
+        (code, f"{args.file}: the plan is {plan.status}: no forces to simulate"),
+    )
+
+
+def _run_export(args: argparse.Namespace) -> tuple[int, str]:
+    from fixplan.sim.mjcf import to_mjcf
+
+    problem_file, plan, failed = _planned(args)
+    if failed:
+        return failed
+    scene = to_mjcf(problem_file.problem, plan, load=args.load, scale=args.scale)
+    try:
+        args.mujoco.write_text(scene.xml, encoding="utf-8")
+    except OSError as exc:
+        raise InvalidArgumentError(
+            f"--mujoco {args.mujoco}: cannot write: {exc.strerror}"
+        ) from None
+    forces = ", ".join(f"{name} {force:.6g} N" for name, force in scene.forces.items())
+    summary = {"scene": str(args.mujoco), "load": scene.load, "forces": scene.forces}
+    text = f"wrote {args.mujoco}: load case {scene.load!r} ramped, forces {forces or 'none'}"
+    return EXIT_OK, _json(summary) if args.json else text
+
+
+def _run_validate(args: argparse.Namespace) -> tuple[int, str]:
+    from fixplan.sim import validate as judge
+
+    problem_file, plan, failed = _planned(args)
+    if failed:
+        return failed
+    if args.report is not None:
+        _check_output_folder(args.report, "--report")
+    cases = judge.validate(problem_file.problem, plan, margin=args.margin, loads=args.load,
+                           progress=_Progress("simulating", not args.quiet))  # fmt: skip
+    if args.report is not None:
+        from fixplan.io.validation_report import write_validation_report
+
+        written = write_validation_report(args.report, problem_file, plan, cases, args.margin)
+        log.info("wrote %d report files to %s", len(written), args.report)
+    code = EXIT_NOT_HELD if any(case.contradicts for case in cases) else EXIT_OK
+    if args.json:
+        return code, _json({"engine": args.engine, "margin": args.margin,
+                            "cases": [_case_document(case) for case in cases]})  # fmt: skip
+    return code, "\n".join(_validation_lines(problem_file, cases, args.margin))
+
+
+def _case_document(case) -> dict:
+    def run(r):
+        return None if r is None else {"held": r.held, "slip_m": r.displacement,
+                                       "rotation_rad": r.rotation,
+                                       "onset_multiple": r.onset_multiple}  # fmt: skip
+
+    return {"load": case.load, "planned_held": case.planned_held,
+            "safety_factor": case.safety_factor, "above": run(case.above),
+            "below": run(case.below), "onset": run(case.onset), "onset_ratio": case.onset_ratio,
+            "motion_angle_rad": case.motion_angle, "contradicts": case.contradicts}  # fmt: skip
+
+
+def _validation_lines(problem_file, cases, margin: float) -> list[str]:
+    from fixplan.sim.validate import HELD_DISPLACEMENT, HELD_ROTATION
+
+    up, down = f"+{margin:.0%}", f"-{margin:.0%}"
+    lines = [
+        f"problem    {problem_file.name}: {len(cases)} load cases simulated in MuJoCo",
+        f"held       no contact slips more than {HELD_DISPLACEMENT * 1e3:g} mm and the part "
+        f"turns less than {HELD_ROTATION:g} rad while the task load ramps to 1x",
+        f"{'load case':28s} {'plan':>8s} {up:>8s} {down:>8s} {'onset/s':>8s} {'motion':>8s}",
+    ]
+    for case in cases:
+        ratio = "-" if case.onset_ratio is None else f"{case.onset_ratio:.3f}"
+        angle = "-" if case.motion_angle is None else f"{math.degrees(case.motion_angle):.1f} deg"
+        verdict = lambda run: "held" if run.held else "slips"  # noqa: E731
+        note = "  <- the plan calls it held" if case.contradicts else ""
+        lines.append(
+            f"{case.load:28s} {'held' if case.planned_held else 'slips':>8s} "
+            f"{verdict(case.above):>8s} {verdict(case.below):>8s} {ratio:>8s} {angle:>8s}{note}"
+        )
+    return lines
 
 
 # -- push ----------------------------------------------------------------------------------------

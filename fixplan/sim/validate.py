@@ -54,7 +54,7 @@ class Run:
 
     @property
     def held(self) -> bool:
-        return self.displacement < HELD_DISPLACEMENT and self.rotation < HELD_ROTATION
+        return bool(self.displacement < HELD_DISPLACEMENT and self.rotation < HELD_ROTATION)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
