@@ -629,13 +629,14 @@ def _case_document(case) -> dict:
 
 
 def _validation_lines(problem_file, cases, margin: float) -> list[str]:
-    from fixplan.sim.validate import HELD_DISPLACEMENT, HELD_ROTATION
+    from fixplan.sim.validate import HELD_DISPLACEMENT
 
     up, down = f"+{margin:.0%}", f"-{margin:.0%}"
     lines = [
         f"problem    {problem_file.name}: {len(cases)} load cases simulated in MuJoCo",
-        f"held       no contact slips more than {HELD_DISPLACEMENT * 1e3:g} mm and the part "
-        f"turns less than {HELD_ROTATION:g} rad while the task load ramps to 1x",
+        f"held       no contact slips more than {HELD_DISPLACEMENT * 1e3:g} mm (its tip against "
+        "the part; area contacts: plus their turn times their radius) while the task load "
+        "ramps to 1x",
         f"{'load case':28s} {'plan':>8s} {up:>8s} {down:>8s} {'onset/s':>8s} {'motion':>8s}",
     ]
     for case in cases:

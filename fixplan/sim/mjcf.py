@@ -44,12 +44,12 @@ OPTIONS = {
     "noslip_iterations": "20",
 }
 #: Soft-contact parameters of every pair: a 5 ms time constant, nearly rigid impedance.
-SOLREF = "0.005 1"
+SOLREF = "0.001 1"
 SOLIMP = "0.99 0.999 0.0005"
 #: Radius [m] of the spheres and half side of the pads of point contacts (patches: their radius).
 POINT_RADIUS = 0.004
 #: Half thickness of a pad [m] relative to its half side.
-PAD_THICKNESS = 0.25
+PAD_THICKNESS = 1.0
 #: Mass [kg] of each finger or clamp sphere (gravity compensated).
 FINGER_MASS = 0.01
 #: Added inertia [kg] of each slide joint: a light sphere under hundreds of newtons would hit the

@@ -4,7 +4,8 @@ For each load case the plan's scene (:func:`~fixplan.sim.mjcf.to_mjcf`) is simul
 times:
 
 - with the active forces scaled up by the margin, the task load ramped to 1× and held: the plan
-  says *held*, so the part must not move (``HELD_DISPLACEMENT``, ``HELD_ROTATION``);
+  says *held*, so no contact may slip (``HELD_DISPLACEMENT``, measured as :func:`simulate`
+  says);
 - scaled down by the margin: a case on its limit (a least-force plan's critical case) must slip;
   the part's twist when it starts to slide is compared with the plan's impending motion;
 - at the planned forces with the task load ramped past the plan's safety factor: the multiple at
@@ -22,10 +23,8 @@ from fixplan.errors import InvalidArgumentError
 from fixplan.planner.problem import Problem
 from fixplan.sim.mjcf import to_mjcf
 
-#: Held: no contact slipped by more than this [m] over the whole run ...
+#: Held: no contact slipped by more than this [m] over the whole run (see :func:`simulate`).
 HELD_DISPLACEMENT = 1e-3
-#: ... and turned less than this [rad].
-HELD_ROTATION = 1e-2
 #: The part slides once a contact slips faster than this [m/s] (tangential speed of its tip
 #: against its pad plus spin about its normal times its radius), after ``SETTLE`` seconds in
 #: which the soft contacts take up the forces.
@@ -41,8 +40,8 @@ ONSET_RAMP, ONSET_REACH = 2.0, 1.5
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Run:
-    """One simulation: the largest slip at a contact [m] and the part's rotation [rad] at the
-    end, and where it started to slide (``None`` if it never did): the task-load multiple then
+    """One simulation: the largest slip at a contact [m] (held below ``HELD_DISPLACEMENT``) and
+    the part's rotation [rad] at the end, and where it started to slide (``None`` if it never did): the task-load multiple then
     and the part's twist ``(v at the world origin [m/s], ω [rad/s])``."""
 
     displacement: float
@@ -54,7 +53,7 @@ class Run:
 
     @property
     def held(self) -> bool:
-        return bool(self.displacement < HELD_DISPLACEMENT and self.rotation < HELD_ROTATION)
+        return bool(self.displacement < HELD_DISPLACEMENT)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -157,9 +156,12 @@ def validate(
 def simulate(scene, seconds: float, problem: Problem, length_scale: float) -> Run:
     """Run ``scene`` from its keyframe for ``seconds``; watch for the onset of sliding.
 
-    Sliding is measured at the contacts, between the part and what presses on it: the tangential
-    displacement of each contact's tip relative to its pad on the part (a finger may follow the
-    part along its normal, which is no slip), and the part's rotation.
+    Sliding is measured at each contact, between the part and what presses on it: the
+    tangential displacement of the contact's tip against its pad on the part (a finger may
+    follow the part along its normal, which is no slip) plus, for contacts with torsional
+    friction, the part's turn about the contact normal times the patch radius. A point contact
+    may spin freely about its normal, as a part pinched by two of them turns about the grasp
+    axis: that is no slip.
     """
     import mujoco
 
@@ -171,36 +173,56 @@ def simulate(scene, seconds: float, problem: Problem, length_scale: float) -> Ru
     tips = [model.geom(f"tip-{c.name}").id for c in problem.contacts]
     pads = [model.geom(f"pad-{c.name}").id for c in problem.contacts]
     normals = np.array([c.normal for c in problem.contacts])  # in the part's frame at the start
-    radii = np.array([model.geom_size[pad][0] for pad in pads])
+    pairs = [model.pair(f"contact-{c.name}").id for c in problem.contacts]
+    torsional = np.array([model.pair_dim[pair] == 4 for pair in pairs])
+    radii = np.where(torsional, [model.geom_size[pad][0] for pad in pads], 0.0)
     turn = data.qpos[3:7].copy()
 
-    def offsets() -> np.ndarray:
-        """Each tip's position relative to its pad, in the part's frame, tangential part."""
+    def slips() -> np.ndarray:
+        """Each contact's tangential offset of its tip from its pad (part frame) [m] and, as a
+        last column, its turn about its normal times its radius [m]."""
         rotation = data.xmat[part].reshape(3, 3)
         relative = (data.geom_xpos[tips] - data.geom_xpos[pads]) @ rotation
-        return relative - np.sum(relative * normals, axis=1)[:, None] * normals
+        tangential = relative - np.sum(relative * normals, axis=1)[:, None] * normals
+        return np.column_stack([tangential, (normals @ _turned(data, turn)) * radii])
 
-    start = previous = offsets()
+    start = previous = slips()
     onset_multiple, onset_twist = None, None
     history = []
     settle, step_time = round(SETTLE / model.opt.timestep), model.opt.timestep
     for step in range(round(seconds / step_time)):
         mujoco.mj_step(model, data)
         if onset_multiple is None:
-            now = offsets()
-            sliding = np.linalg.norm(now - previous, axis=1) / step_time
+            now = slips()
+            speed = np.linalg.norm(now[:, :3] - previous[:, :3], axis=1) + np.abs(
+                now[:, 3] - previous[:, 3]
+            )
             previous = now
-            twist = _twist(data)
-            spinning = np.abs(normals @ (data.xmat[part].reshape(3, 3).T @ twist[3:])) * radii
-            if step >= settle and np.max(sliding + spinning) > SLIP_SPEED:
-                onset_multiple, onset_twist = float(data.act[-1]), twist
+            if step >= settle and np.max(speed) / step_time > SLIP_SPEED:
+                onset_multiple, onset_twist = float(data.act[-1]), _twist(data)
         if step % HISTORY_STRIDE == 0:
-            slip = float(np.max(np.linalg.norm(offsets() - start, axis=1)))
-            history.append((data.time, slip, _rotation(data, turn), float(data.act[-1])))
-    slip = float(np.max(np.linalg.norm(offsets() - start, axis=1)))
-    history.append((data.time, slip, _rotation(data, turn), float(data.act[-1])))
-    return Run(displacement=slip, rotation=_rotation(data, turn), onset_multiple=onset_multiple,
-               onset_twist=onset_twist, history=np.array(history))  # fmt: skip
+            history.append(_sample(data, slips() - start, turn))
+    history.append(_sample(data, slips() - start, turn))
+    return Run(displacement=float(history[-1][1]), rotation=_rotation(data, turn),
+               onset_multiple=onset_multiple, onset_twist=onset_twist,
+               history=np.array(history))  # fmt: skip
+
+
+def _sample(data, slipped: np.ndarray, turn: np.ndarray) -> tuple[float, float, float, float]:
+    """A history row: time, largest slip at a contact, rotation, task multiple."""
+    largest = float(np.max(np.linalg.norm(slipped[:, :3], axis=1) + np.abs(slipped[:, 3])))
+    return (data.time, largest, _rotation(data, turn), float(data.act[-1]))
+
+
+def _turned(data, start: np.ndarray) -> np.ndarray:
+    """The part's rotation vector [rad] since orientation ``start``, in its starting frame."""
+    import mujoco
+
+    inverse, relative, vector = np.zeros(4), np.zeros(4), np.zeros(3)
+    mujoco.mju_negQuat(inverse, start)
+    mujoco.mju_mulQuat(relative, inverse, data.qpos[3:7])
+    mujoco.mju_quat2Vel(vector, relative, 1.0)
+    return vector
 
 
 def _rotation(data, start: np.ndarray) -> float:
