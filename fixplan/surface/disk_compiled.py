@@ -59,6 +59,7 @@ _CARLSON_ITERATIONS = 40
 
 
 def _hypergeometric_series(a: float, b: float, c: float) -> np.ndarray:
+    """The first :data:`SERIES_TERMS` power-series coefficients of ``₂F₁(a, b; c; z)``."""
     n = np.arange(SERIES_TERMS, dtype=float)
     return poch(a, n) * poch(b, n) / (poch(c, n) * poch(1.0, n))
 
