@@ -169,7 +169,7 @@ def bench_accuracy() -> None:
 
 
 def per_call_surfaces() -> dict:
-    """The surfaces of the per-call benchmark: point supports (facets), a polygon, a disk."""
+    """The surfaces of the per-call benchmark: point supports (facets), a polygon, disks."""
     xy = np.random.default_rng(1).uniform(-0.05, 0.05, size=(4096, 2))
     triangle = 0.05 * np.array([[0.0, 1.0], [-0.866, -0.5], [0.866, -0.5]])
     return {
@@ -177,6 +177,10 @@ def per_call_surfaces() -> dict:
         "3 points": LimitSurface(pressure.points(triangle), mu=0.5, normal_force=30.0),
         "rectangle 10:1": LimitSurface(pressure.rectangle(0.1, 0.01), mu=0.25, normal_force=200.0),
         "uniform disk": LimitSurface(pressure.disk(0.01), mu=0.5, normal_force=10.0),
+        "Hertz disk": LimitSurface(pressure.disk(0.01, "hertz"), mu=0.5, normal_force=10.0),
+        "annulus": LimitSurface(
+            pressure.disk(0.01, "annulus", inner_radius=0.006), mu=0.5, normal_force=10.0
+        ),
     }
 
 

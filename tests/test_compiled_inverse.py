@@ -25,11 +25,24 @@ MOTION_RAD = 1e-9  # ... and the motions to about that angle
 rng0 = np.random.default_rng(11)
 CLOUD = rng0.uniform(-0.05, 0.05, size=(300, 2))
 
-#: The shared surfaces the compiled path covers (points, polygons, grids), and two more cases.
+#: The shared surfaces the compiled path covers (points, polygons, grids, disks), and more.
 SURFACES = {
     name: SHARED_SURFACES[name]
-    for name in ("three points", "rectangle 10:1", "rotated shifted rectangle", "tactile grid")
+    for name in (
+        "three points",
+        "rectangle 10:1",
+        "rotated shifted rectangle",
+        "tactile grid",
+        "uniform disk",
+        "hertz disk",
+        "parabolic disk",
+        "annulus",
+        "ring",
+    )
 } | {
+    "shifted Hertz disk": lambda: LimitSurface(
+        pressure.disk(0.005, "hertz").shifted(0.01, -0.004), mu=0.5, normal_force=3.0
+    ),
     "300 weighted points": lambda: LimitSurface(
         pressure.points(CLOUD, rng0.uniform(0.2, 2.0, len(CLOUD))), mu=0.4, normal_force=80.0
     ),
@@ -115,11 +128,12 @@ def test_kernels_without_a_compiled_form_keep_the_numpy_path():
     points = PointSetKernel(np.array([[0.0, 0.0], [0.01, 0.0]]), np.array([0.5, 0.5]), True)
     disk = DiskKernel(0.01, "uniform")
     pose = pressure.disk(0.01).shifted(0.01, 0.0).pose
-    assert compile_kernel(disk) is None
     assert compile_kernel(SumKernel((disk, points), (1.0, 1.0))) is None
     assert compile_kernel(PosedKernel(points, pose)) is None  # facets live in the contact frame
     assert compile_kernel(points.smoothed(1e-3)) is None
     assert compile_kernel(points) is not None
+    assert compile_kernel(disk) is not None
+    assert compile_kernel(PosedKernel(disk, pose)) is not None
 
 
 def test_the_convergence_error_names_the_load_and_what_to_do():

@@ -8,11 +8,12 @@ iteration is gone (a few microseconds per query on a few points instead of half 
 
 Kernels are passed as a tuple ``(kind, x, y, weights, edges, reach, transform, posed)``: points
 ``x``, ``y`` [m] with friction ``weights`` (the far-field rule of a polygon), the polygon's edge
-table ``(7, E)`` and its far-field radius ``reach`` [m] (``kind`` :data:`EDGES`), and the
-``transform`` (3x3) from contact-frame to local twists when ``posed``.
+table ``(7, E)`` and its far-field radius ``reach`` [m] (``kind`` :data:`EDGES`) or the disk
+table ``(3, D)`` in its place (``kind`` :data:`DISKS`), and the ``transform`` (3x3) from
+contact-frame to local twists when ``posed``.
 
-The per-twist terms come from :mod:`~fixplan.surface.point_kernel` and
-:mod:`~fixplan.surface.polygon_kernel`. numba keys its on-disk cache by each compiled function's
+The per-twist terms come from :mod:`~fixplan.surface.point_kernel`,
+:mod:`~fixplan.surface.polygon_kernel` and :mod:`~fixplan.surface.disk_compiled`. numba keys its on-disk cache by each compiled function's
 own file, so after editing those modules in a working copy, delete the cache folder
 (:func:`~fixplan.surface.point_kernel.user_cache_dir`): the cached loops here would keep the old
 terms. (Installing a new version replaces every file, which invalidates the whole cache.)
@@ -27,6 +28,8 @@ import numba
 import numpy as np
 
 from fixplan.errors import ConvergenceError
+from fixplan.surface.disk_compiled import _DISK_TERMS, PROFILES
+from fixplan.surface.disk_kernel import AnnulusKernel, DiskKernel
 from fixplan.surface.kernels import PosedKernel, SupportKernel, twist_to_local
 from fixplan.surface.point_kernel import (
     _POINT_TERMS,
@@ -44,9 +47,11 @@ from fixplan.tolerances import (
     INVERSE_RTOL,
 )
 
-#: Kinds of compiled kernels: weighted points, or polygon edges with a far-field point rule.
+#: Kinds of compiled kernels: weighted points, polygon edges with a far-field point rule, or
+#: closed-form disks.
 POINTS = 0
 EDGES = 1
+DISKS = 2
 
 #: Number of nearest support points whose facets are tested per query.
 FACETS_TESTED = 3
@@ -55,8 +60,8 @@ FACETS_TESTED = 3
 #: there the iteration is quadratic and rounding would defeat the sufficient-decrease test.
 QUADRATIC_REGION = 1e-12
 
-#: A support point whose weighted speed is below this fraction of the safety factor sits on a
-#: possible kink.
+#: A support point whose weighted speed is below this fraction of the support value (both of
+#: the unit-friction kernel) sits on a possible kink.
 NEAR_KINK = 1e-6
 
 #: Kink handling of :func:`_newton`: none (smooth functions), stop where steps crawl into a
@@ -96,7 +101,9 @@ def _terms(kernel, eps2, twist, with_hessian, local, out):  # pragma: no cover -
             t[2, 0] * twist[0] + t[2, 1] * twist[1] + t[2, 2] * twist[2],
         )
     target = local if posed else out
-    if kind == EDGES and abs(w) * reach > math.sqrt(vx * vx + vy * vy):
+    if kind == DISKS:
+        _DISK_TERMS(edges, vx, vy, w, with_hessian, target)
+    elif kind == EDGES and abs(w) * reach > math.sqrt(vx * vx + vy * vy):
         _EDGE_TERMS(edges, vx, vy, w, with_hessian, target)
     else:
         _POINT_TERMS(px, py, pw, eps2, vx, vy, w, with_hessian, target)
@@ -182,6 +189,15 @@ def _newton(kernel, eps2, twist, b1, b2, kinks):  # pragma: no cover - compiled
         for i in range(3):
             step[i] = s1 * b1[i] + s2 * b2[i]
             trial[i] = twist[i] + step[i]
+        if decrement <= QUADRATIC_REGION * h:
+            # The full step is taken; it nearly always ends the iteration, which the decrement
+            # at its gradient with this Hessian (a relative change of the size of the step)
+            # shows without the cost of a new Hessian.
+            _terms(kernel, eps2, trial, False, local, new)
+            new[4:] = current[4:]
+            if _newton_step(*_projected(new, b1, b2))[2] <= INVERSE_RTOL**2 * new[0]:
+                twist[:] = trial
+                return False, new[0], -1
         # The full step is tried with the terms of the next iteration: it is nearly always taken.
         _terms(kernel, eps2, trial, True, local, new)
         t = 1.0
@@ -293,12 +309,15 @@ def _certify_kink(kernel, load, scale, twist, b1, b2, k):  # pragma: no cover - 
     (``twist`` unchanged) otherwise. Either is a certificate: ``h`` is convex on the plane."""
     facet = np.empty(3)
     rest = np.empty(10)
-    s_k = _facet(kernel, load, scale, k, facet, True, rest)
+    s_k = _facet(kernel, load, scale, k, facet, False, rest)
     if s_k < np.inf:
         twist[:] = facet
         return s_k
     if math.isnan(s_k):
         return 0.0
+    # Off the facet: the escape also needs the other points' Hessian there.
+    local = np.empty(10)
+    _terms(kernel, 0.0, facet, True, local, rest)
     return scale * _escape_kink(kernel, twist, b1, b2, k, facet, rest)
 
 
@@ -408,7 +427,7 @@ def _solve_load(kernel, discrete, load, units, scale, twist):  # pragma: no cove
         index = np.empty(1, dtype=np.int64)
         speed = np.empty(1)
         _slowest(kernel, twist, index, speed)
-        if stalled or speed[0] <= NEAR_KINK * safety:
+        if stalled or speed[0] <= NEAR_KINK * h:
             safety, on_facet = _facets(kernel, load, scale, twist, safety)
         if stalled and not on_facet:
             certified = _certify_kink(kernel, load, scale, twist, b1, b2, index[0])
@@ -508,13 +527,22 @@ def not_converged(load: np.ndarray, relative_gradient: float) -> ConvergenceErro
     )
 
 
+#: Work of one disk in terms of points summed (it sets when a batch runs in parallel).
+DISK_WORK = 64
+
+
 def compile_kernel(kernel: SupportKernel) -> CompiledKernel | None:
-    """The compiled form of a point-set or polygon kernel, posed or not (``None`` for others,
-    which take the NumPy path)."""
+    """The compiled form of a point-set, polygon or disk kernel, posed or not (``None`` for
+    others, which take the NumPy path)."""
     transform, posed = np.eye(3), False
     if isinstance(kernel, PosedKernel):
         transform, posed, kernel = twist_to_local(kernel.pose), True, kernel.local
     no_edges = np.empty((7, 0))
+    no_points = np.empty(0)
+    disks = _disk_table(kernel)
+    if disks is not None:
+        parts = (DISKS, no_points, no_points, no_points, disks, 0.0, transform, posed)
+        return CompiledKernel(parts=parts, discrete=False, work=DISK_WORK * disks.shape[1])
     if isinstance(kernel, PointSetKernel) and kernel.smoothing == 0.0:
         if posed and kernel.discrete:
             return None  # facets are tested in the contact frame
@@ -526,6 +554,19 @@ def compile_kernel(kernel: SupportKernel) -> CompiledKernel | None:
         parts = (EDGES, *_point_columns(kernel.far), edges, reach, transform, posed)
         return CompiledKernel(parts=parts, discrete=False, work=kernel.edge_table.shape[1])
     return None
+
+
+def _disk_table(kernel: SupportKernel) -> np.ndarray | None:
+    """The disk table ``(3, D)`` (radius [m], profile row, weight) of a disk or annulus kernel;
+    ``None`` for other kernels."""
+    if isinstance(kernel, DiskKernel):
+        disks = [(kernel.radius, PROFILES.index(kernel.profile), 1.0)]
+    elif isinstance(kernel, AnnulusKernel):
+        disks = [(part.radius, PROFILES.index(part.profile), weight)
+                 for part, weight in kernel.parts]  # fmt: skip
+    else:
+        return None
+    return np.array(disks, dtype=float).T.copy()
 
 
 def _point_columns(kernel: PointSetKernel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

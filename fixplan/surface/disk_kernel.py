@@ -229,20 +229,22 @@ class AnnulusKernel(SupportKernel):
     def size(self) -> float:
         return self.radius
 
-    def _parts(self):
+    @property
+    def parts(self) -> tuple[tuple[DiskKernel, float], ...]:
+        """The two uniform disks with their weights (the outer positive, the inner negative)."""
         s2 = (self.inner_radius / self.radius) ** 2
         outer = DiskKernel(self.radius, "uniform")
         inner = DiskKernel(self.inner_radius, "uniform")
         return (outer, 1.0 / (1.0 - s2)), (inner, -s2 / (1.0 - s2))
 
     def evaluate(self, twists):
-        (outer, wo), (inner, wi) = self._parts()
+        (outer, wo), (inner, wi) = self.parts
         ho, lo = outer.evaluate(twists)
         hi, li = inner.evaluate(twists)
         return wo * ho + wi * hi, wo * lo + wi * li
 
     def newton_terms(self, twists):
-        (outer, wo), (inner, wi) = self._parts()
+        (outer, wo), (inner, wi) = self.parts
         ho, go, hesso = outer.newton_terms(twists)
         hi, gi, hessi = inner.newton_terms(twists)
         return wo * ho + wi * hi, wo * go + wi * gi, wo * hesso + wi * hessi

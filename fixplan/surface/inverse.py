@@ -144,7 +144,7 @@ def solve(
     if len(points):
         # Newton only stops short, or lands on a kink, next to a support point.
         _, slowest = slowest_points(points, friction, z / units, 1)
-        near_kink = slowest[:, 0] <= NEAR_KINK * safety
+        near_kink = slowest[:, 0] <= NEAR_KINK * safety / scale
         rows = np.flatnonzero(stalled | near_kink)
         on_facet = _facets(kernel, scale, loads, units, z, safety, points, friction, rows)
         retry = np.flatnonzero(stalled & ~on_facet)

@@ -93,6 +93,7 @@ class LimitSurface:
         "_mu",
         "_normal_force",
         "_parts",
+        "_rho",
         "_scale",
         "_shape",
         "_units",
@@ -132,6 +133,8 @@ class LimitSurface:
         probe = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
         max_force, max_moment = scale * kernel.support(probe)
         self._units = np.array([max_force, max_force, max_moment])
+        force, moment = (self._units if shape is None else shape._units)[1:].tolist()
+        self._rho = moment / force if force > 0.0 else math.nan  # 0: mu(x, y) = 0, refused
 
     @classmethod
     def combine(cls, surfaces: Iterable[LimitSurface]) -> LimitSurface:
@@ -198,8 +201,7 @@ class LimitSurface:
     def characteristic_length(self) -> float:
         """``rho = max_moment / max_force`` [m], the scale of the paper's normalised plots
         (of a frictionless surface: that of its :attr:`friction_shape`)."""
-        shape = self.friction_shape
-        return shape.max_moment / shape.max_force
+        return self._rho
 
     def __repr__(self) -> str:
         what = f"{len(self._parts)} parts" if self._parts else type(self.field).__name__
@@ -298,7 +300,7 @@ class LimitSurface:
         return self._unit_twists(twists), safety
 
     def _unit_twists(self, twists: np.ndarray) -> np.ndarray:
-        rho = self.characteristic_length
+        rho = self._rho
         if twists.ndim == 1:  # one query: floats cost less than NumPy calls
             vx, vy, w = twists.tolist()
             return twists / math.sqrt(vx * vx + vy * vy + (rho * w) ** 2)
