@@ -24,6 +24,7 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+from performance_rows import emit
 
 from fixplan import LimitSurface, pressure
 
@@ -79,6 +80,12 @@ def bench_forward(n_points: int, n_twists: int, repeats: int) -> None:
     print(f"  speed-up                   {base / fast:9.1f} x")
     print(f"  agreement                  {error:9.1e} (max relative difference)")
     print(f"  peak resident memory       {rss_after / 1024:9.0f} MB (whole process, incl. numba)")
+    emit(
+        f"forward map, {n_points:,} points × {n_twists:,} twists",
+        f"{pairs / fast / 1e6:,.0f} M evaluations/s (peak memory {rss_after / 1024:.0f} MB)",
+        f"NumPy broadcast {pairs / base / 1e6:,.0f} M/s",
+        f"{base / fast:.0f}×",
+    )
     del rss_before
 
 
@@ -144,6 +151,13 @@ def bench_inverse(n_points: int, n_queries: int, n_socp: int, repeats: int) -> N
     print(f"  speed-up                   {socp * n_queries / fast:9.0f} x")
     print(f"  safety factor agreement    {safety_gap:9.1e} (max relative difference)")
     print(f"  motion agreement           {max(angles):9.1e} rad (max angle)")
+    emit(
+        f"inverse map (safety factor + motion), {n_points:,}-point field, batched",
+        f"{n_queries / fast:,.0f} queries/s (agreement: safety {safety_gap:.1e}, motion "
+        f"{max(angles):.1e} rad)",
+        f"cvxpy + Clarabel SOCP {1.0 / socp:.1f} queries/s",
+        f"{socp * n_queries / fast:,.0f}×",
+    )
 
 
 def bench_accuracy() -> None:
@@ -297,6 +311,29 @@ def bench_per_call(count: int, batch_repeats: int, ref: str) -> None:
         if row["failed"]:
             line += f"  ({row['failed']} ConvergenceError)"
         print(line)
+    _emit_per_call(new, old, ref)
+
+
+def _emit_per_call(new: dict, old: dict | None, ref: str) -> None:
+    """One performance-table row per surface: medians and p99 over its load distributions."""
+    surfaces = dict.fromkeys(key.split(" | ")[0].strip() for key in new)
+    for surface in surfaces:
+        keys = [key for key in new if key.split(" | ")[0].strip() == surface]
+        medians = [new[key]["median"] * 1e6 for key in keys]
+        tails = [new[key]["p99"] * 1e6 for key in keys]
+        baseline, ratio = "", ""
+        if old is not None and all(key in old for key in keys):
+            was = [old[key]["median"] * 1e6 for key in keys]
+            baseline = f"{ref[:7]}: {min(was):,.1f}–{max(was):,.1f} µs"
+            ratios = [w / m for w, m in zip(was, medians, strict=True)]
+            ratio = f"{min(ratios):.1f}–{max(ratios):.1f}×"
+        emit(
+            f"inverse map per call, {surface} ({len(keys)} load distributions)",
+            f"median {min(medians):.1f}–{max(medians):.1f} µs, p99 {min(tails):.0f}–"
+            f"{max(tails):.0f} µs",
+            baseline,
+            ratio,
+        )
 
 
 def main() -> None:

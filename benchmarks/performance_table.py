@@ -28,7 +28,10 @@ END = "<!-- performance-table:end -->"
 
 #: The benchmarks behind the table, with their arguments, in the table's order.
 BENCHMARKS = (
+    ("bench_limit_surface.py", ()),
     ("bench_models.py", ()),
+    ("bench_planner.py", ()),
+    ("bench_exact.py", ()),
     ("bench_realtime.py", ()),
     ("bench_pushing.py", ()),
 )

@@ -462,3 +462,22 @@ def test_the_pushing_example_runs_and_writes_its_figures(tmp_path):
     assert "flush against the face after 59.8 mm of pusher travel" in result.stdout
     for name in ("push-finger.png", "push-finger.gif", "push-flat.png", "push-flat.gif"):
         assert (tmp_path / name).stat().st_size > 10_000
+
+
+@pytest.mark.slow
+def test_mujoco_confirms_the_critical_case_of_every_least_force_plan(tmp_path):
+    """``examples/validate_library.py --quick``: the critical case of every problem with an
+    optimal plan, held at +10 % whenever the plan holds it, on the limit (slip onset within 2 %
+    of the safety factor) where a least-force plan put it."""
+    table = tmp_path / "table.md"
+    result = subprocess.run(
+        [sys.executable, str(EXAMPLES / "validate_library.py"), "--quick", "--markdown",
+         str(table)],
+        capture_output=True, text=True, timeout=600, cwd=tmp_path,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stdout + result.stderr
+    rows = {line.split(" | ")[0].strip("| "): line.split(" | ") for line in
+            table.read_text(encoding="utf-8").splitlines()[2:]}  # fmt: skip
+    for name in ("hertz-pinch", "point-grasp", "fixture-321", "three-finger-grasp"):
+        assert rows[name][3] == "held" and rows[name][4] == "slips", rows[name]
+        assert float(rows[name][5]) == pytest.approx(1.0, abs=0.02), rows[name]
