@@ -293,7 +293,7 @@ class Planner:
             )  # fmt: skip
 
         cases = wrenches.shape[1]
-        if self.squeeze_contacts or not given:
+        if self.squeeze_contacts or not given or cases == 1:
             return minimised(np.arange(cases), progress)
         columns = np.vstack([np.broadcast_to(v, (cases,)) for v in given.values()])
         _, first, group = np.unique(columns.T, axis=0, return_index=True, return_inverse=True)
