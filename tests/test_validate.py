@@ -43,6 +43,18 @@ def test_point_contacts_hold_every_case_at_110_percent_and_the_critical_one_slip
     assert not cases[plan.critical_load].below.held
 
 
+def test_the_nose_cone_squeezed_by_point_fingers_is_held_at_110_percent_and_slips_at_90():
+    """Lobo and Boyd's nose cone (five point fingers whose forces alone push it out): held at
+    +10 %, slipping at -10 %, the slip beginning within 2 % of the planned load."""
+    import reference_planner as ref
+
+    problem = ref.nose_cone_problem()
+    plan = Planner(problem).solve()
+    (case,) = validate(problem, plan)
+    assert case.above.held and not case.below.held
+    assert case.onset_ratio == pytest.approx(1.0, abs=0.02)
+
+
 def test_bad_requests_are_refused():
     problem, plan = _planned("hertz-pinch")
     with pytest.raises(InvalidArgumentError, match="margin"):

@@ -3,7 +3,8 @@
 For each load case the plan's scene (:func:`~fixplan.sim.mjcf.to_mjcf`) is simulated three
 times:
 
-- with the active forces scaled up by the margin, the task load ramped to 1× and held: the plan
+- with the active forces scaled up by the margin, the task load ramped to 1× (from the lower end
+  of the held interval of the scaled forces, which the planner gives) and held: the plan
   says *held*, so no contact may slip (``HELD_DISPLACEMENT``, measured as :func:`simulate`
   says);
 - scaled down by the margin: a case on its limit (a least-force plan's critical case) must slip;
@@ -15,7 +16,7 @@ times:
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -126,15 +127,16 @@ def validate(
     found = []
     for done, name in enumerate(names):
         safety = float(plan.safety_factors[name])
-        lowest = min(float(plan.held_intervals[name][0]), 1.0)  # where the ramps start
         runs = {}
         for key, factor in (("above", 1 + margin), ("below", 1 - margin)):
+            lowest = _lower_end(problem, plan, name, factor)  # where the ramp starts
             ramp = RAMP / (1.0 - lowest) if lowest < 1.0 else RAMP
             scene = to_mjcf(problem, plan, load=name, scale=factor, ramp=ramp, max_multiple=1.0,
                             start=lowest)  # fmt: skip
             runs[key] = simulate(scene, RAMP + HOLD, problem, scale)
         above, below = runs["above"], runs["below"]
         onset = None
+        lowest = min(float(plan.held_intervals[name][0]), 1.0)
         if np.isfinite(safety):
             reach = ONSET_REACH * safety
             scene = to_mjcf(problem, plan, load=name, ramp=ONSET_RAMP / (reach - lowest),
@@ -151,6 +153,27 @@ def validate(
         if progress is not None:
             progress(done + 1, len(names))
     return found
+
+
+def _lower_end(problem: Problem, plan, load: str, factor: float) -> float:
+    """Where a run with the active forces of case ``load`` scaled by ``factor`` starts its ramp:
+    the lower end of the held interval of those forces (at most 1), from the planner (a part
+    that the forces alone push out, like a squeezed nose cone, is held only from there on)."""
+    from fixplan.planner.planner import Planner
+
+    case = plan.load_names.index(load)
+    contacts = []
+    for contact in problem.contacts:
+        if contact.is_active:
+            force = np.atleast_1d(plan.forces[contact.name])
+            contact = replace(
+                contact, force=factor * float(force[case] if force.size > 1 else force[0])
+            )
+        contacts.append(contact)
+    single = replace(problem, contacts=tuple(contacts), loads=(problem.loads[case],),
+                     objective="check")  # fmt: skip
+    interval = (Planner(single).solve().held_intervals or {}).get(load)
+    return 0.0 if interval is None else min(float(interval[0]), 1.0)  # none held: from 0
 
 
 def simulate(scene, seconds: float, problem: Problem, length_scale: float) -> Run:
