@@ -4,6 +4,7 @@ MuJoCo is the independent judge: a least-force plan scaled up by 10 % must hold 
 load case as its task load ramps to 1×, and scaled down by 10 % must let it slip.
 """
 
+import dataclasses
 from pathlib import Path
 
 import mujoco
@@ -76,3 +77,17 @@ def test_bad_forces_and_load_names_are_refused(plans):
         to_mjcf(problem, plan, forces={"finger-left": -1.0})
     with pytest.raises(InvalidArgumentError, match="load must be one of"):
         to_mjcf(problem, plan, load="nothing")
+
+
+def test_contact_names_with_quotes_and_brackets_make_a_valid_scene(plans):
+    problem, plan = plans["three-pads"]
+    odd = {c.name: f'{c.name} "x" <&>' for c in problem.contacts}
+    contacts = tuple(dataclasses.replace(c, name=odd[c.name]) for c in problem.contacts)
+    renamed = dataclasses.replace(problem, contacts=contacts)
+    forces = {odd[name]: force for name, force in scene_forces(problem, plan).items()}
+    model = mujoco.MjModel.from_xml_string(to_mjcf(renamed, forces=forces).xml)
+    assert model.geom(f"tip-{contacts[0].name}").id >= 0
+
+
+def scene_forces(problem, plan) -> dict:
+    return to_mjcf(problem, plan).forces

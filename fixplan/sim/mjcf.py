@@ -196,7 +196,7 @@ def _pads(problem: Problem, center: np.ndarray) -> list[str]:
         thickness = PAD_THICKNESS * half
         middle = contact.position + thickness * contact.normal - center
         lines.append(
-            f'<geom name="pad-{contact.name}" type="box" size="{half:.9g} {half:.9g} '
+            f'<geom name={_named("pad", contact.name)} type="box" size="{half:.9g} {half:.9g} '
             f'{thickness:.9g}" pos="{_numbers(middle)}" zaxis="{_numbers(contact.normal)}" '
             'contype="0" conaffinity="0" mass="0" rgba="0.9 0.6 0.2 1"/>'
         )
@@ -210,15 +210,15 @@ def _contact_bodies(problem: Problem) -> list[str]:
         radius = _size(contact)
         place = contact.position - radius * contact.normal
         geom = (
-            f'<geom name="tip-{contact.name}" type="sphere" size="{radius:.9g}" '
+            f'<geom name={_named("tip", contact.name)} type="sphere" size="{radius:.9g}" '
             'contype="0" conaffinity="0" rgba="0.3 0.5 0.9 1"'
         )
         if not contact.is_active:
             lines.append(f'{geom} pos="{_numbers(place)}"/>')
             continue
         lines += [
-            f'<body name="finger-{contact.name}" pos="{_numbers(place)}" gravcomp="1">',
-            f'  <joint name="slide-{contact.name}" type="slide" '
+            f'<body name={_named("finger", contact.name)} pos="{_numbers(place)}" gravcomp="1">',
+            f'  <joint name={_named("slide", contact.name)} type="slide" '
             f'axis="{_numbers(contact.normal)}" armature="{FINGER_ARMATURE:.9g}"/>',
             f'  {geom} mass="{FINGER_MASS:.9g}"/>',
             "</body>",
@@ -231,8 +231,8 @@ def _pairs(problem: Problem) -> list[str]:
     for contact in problem.contacts:
         attributes = mujoco_contact(contact).attributes()
         lines.append(
-            f'<pair name="contact-{contact.name}" geom1="tip-{contact.name}" '
-            f'geom2="pad-{contact.name}" condim="{attributes["condim"]}" '
+            f"<pair name={_named('contact', contact.name)} geom1={_named('tip', contact.name)} "
+            f'geom2={_named("pad", contact.name)} condim="{attributes["condim"]}" '
             f'friction="{attributes["friction"]}" solref="{SOLREF}" solimp="{SOLIMP}"/>'
         )
     return lines
@@ -287,7 +287,7 @@ def _part_shape(body, center: np.ndarray) -> list[str]:
 
 def _motors(problem: Problem) -> list[str]:
     return [
-        f'    <motor name="push-{c.name}" joint="slide-{c.name}" gear="1"/>'
+        f'    <motor name={_named("push", c.name)} joint={_named("slide", c.name)} gear="1"/>'
         for c in problem.contacts
         if c.is_active
     ]
@@ -296,6 +296,12 @@ def _motors(problem: Problem) -> list[str]:
 def _controls(problem: Problem, forces: dict, ramp: float) -> str:
     values = [forces[c.name] for c in problem.contacts if c.is_active] + [1.0 / ramp]
     return _numbers(values)
+
+
+def _named(prefix: str, name: str) -> str:
+    """The quoted MJCF attribute value ``prefix-name`` (contact names may hold any printable
+    character)."""
+    return quoteattr(f"{prefix}-{name}")
 
 
 def _attributes(values: dict, **more: str) -> str:
