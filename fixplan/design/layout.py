@@ -14,7 +14,9 @@ that the problem's objective is best, and returns the best layouts with their pl
   (:mod:`fixplan.design.relaxation`) ranks the candidates by the force they carry; the
   ``choose`` counts with the most force per role start a best-improvement local search over
   swaps of one candidate (and additions or removals within a range), the swaps drawn from the
-  ``SWAP_POOL`` best-ranked candidates of the role. It finds a local optimum, not a proven one.
+  ``SWAP_POOL`` best-ranked candidates of the role; ``KICKS`` restarts from the best layout with
+  up to ``KICK_SIZE`` candidates per role swapped at random (seeded) escape some of its local
+  optima. It finds a local optimum, not a proven one.
 - ``mode="auto"``: exact when the enumeration has at most ``EXACT_MAX_LAYOUTS`` layouts.
 
 The plans of the layouts returned are solved again on their own problems (only the chosen and the
@@ -44,6 +46,10 @@ MODES = ("auto", "exact", "large")
 EXACT_MAX_LAYOUTS = 5000
 #: Candidates per role, best-ranked by the relaxation, that the large mode's swaps draw from.
 SWAP_POOL = 24
+#: Restarts of the large mode's descent from a kicked copy of the best layout (iterated local
+#: search), and how many candidates of each role a kick swaps.
+KICKS = 8
+KICK_SIZE = 2
 #: A candidate carries force in the relaxation when its force is above this fraction of the
 #: largest.
 ACTIVE_RTOL = 1e-3
@@ -219,6 +225,19 @@ class LayoutSearch:
         for role, (members, low, high) in self.roles.items():
             wanted = min(max(int(carrying[list(members)].sum()), low), high)
             current[role] = tuple(ranking[role][:wanted])
+        score, current = self._descend(current, ranking)
+        rng = np.random.default_rng(0)
+        for _ in range(KICKS):
+            kicked = self._kick(current, ranking, rng)
+            kicked_score, kicked = self._descend(kicked, ranking)
+            if kicked_score < score:
+                score, current = kicked_score, kicked
+        return [(visited, ()) for visited in evaluator.ranked()]
+
+    def _descend(self, current, ranking):
+        """Best-improvement descent over :meth:`_moves` from ``current``: its score and layout
+        (per role)."""
+        evaluator = self.evaluator
         layout = self._join(current)
         score = evaluator.score(layout)
         while True:
@@ -228,10 +247,21 @@ class LayoutSearch:
             ]
             better = min(moves, default=(math.inf, None))
             if not better[0] < score:
-                break
+                return score, current
             score, layout = better
             current = self._split(layout)
-        return [(visited, ()) for visited in evaluator.ranked()]
+
+    def _kick(self, current, ranking, rng):
+        """``current`` with up to ``KICK_SIZE`` candidates of each role swapped for random ones
+        of its pool: a restart that a single swap cannot reach."""
+        kicked = {}
+        for role, chosen in current.items():
+            pool = [i for i in ranking[role] if i not in chosen][:SWAP_POOL]
+            count = min(KICK_SIZE, len(chosen), len(pool))
+            out = set(rng.choice(len(chosen), count, replace=False).tolist()) if count else set()
+            into = rng.choice(pool, count, replace=False).tolist() if count else []
+            kicked[role] = (*(c for k, c in enumerate(chosen) if k not in out), *into)
+        return kicked
 
     def _moves(self, current, ranking):
         for role, (_, low, high) in self.roles.items():
