@@ -45,8 +45,9 @@ SETTLE = 0.1
 SLIP_SPEED = 1e-4
 #: The ramp of the load over the exact limit surface's load: start, rate [1/s] and end multiple.
 RAMP_START, RAMP_RATE, RAMP_END = 0.95, 0.5, 1.2
-#: Newton steps on the penetration that makes the field's resultant the normal force.
-PRESS_STEPS = 30
+#: Steps on the penetration that makes the field's resultant the normal force, and their
+#: relative tolerance on that resultant.
+PRESS_STEPS, PRESS_RTOL = 30, 1e-9
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -280,8 +281,13 @@ class _Scene:
         for _ in range(PRESS_STEPS):
             self.height.set_translation(self.plant_context, self.radius - depth)
             resultant = self._geometric_resultant()
+            if resultant == 0.0:
+                raise InvalidArgumentError(
+                    f"the fingertip's mesh makes no contact at {depth!r} m: give a finer "
+                    "resolution or a larger normal_force"
+                )
             depth *= np.sqrt(normal_force / resultant)
-            if abs(resultant / normal_force - 1.0) < 1e-9:
+            if abs(resultant / normal_force - 1.0) < PRESS_RTOL:
                 break
         self.height.set_translation(self.plant_context, self.radius - depth)
         self._apply(np.zeros(3))
@@ -309,12 +315,9 @@ class _Scene:
             )
         surface = results.hydroelastic_contact_info(0).contact_surface()
         centroids, areas, pressures = _polygons(surface)
-        return centroids[:, :2] - self._position()[:2], areas, pressures
-
-    def _position(self) -> np.ndarray:
-        """The fingertip's ``(x, y, θ)`` [m, m, rad]."""
-        q = self.plant.GetPositions(self.plant_context)
-        return q[self.planar.position_start() : self.planar.position_start() + 3]
+        start = self.planar.position_start()
+        axis = self.plant.GetPositions(self.plant_context)[start : start + 2]
+        return centroids[:, :2] - axis, areas, pressures
 
     def _apply(self, load: np.ndarray) -> None:
         """Press with the normal force and apply ``load`` ``(fx, fy, m)`` [N, N, N m]."""
