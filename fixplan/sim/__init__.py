@@ -1,5 +1,13 @@
-"""Simulators: fixplan's contact models as the parameters of physics engines (MuJoCo)."""
+"""Simulators: fixplan's contact models as the parameters of physics engines (MuJoCo), and Drake's
+hydroelastic contact as a check of the exact limit surface."""
 
+from fixplan.sim.drake_check import DirectionResult, HydroelasticCheck, hydroelastic_check
 from fixplan.sim.mujoco_contact import MujocoContact, mujoco_contact
 
-__all__ = ["MujocoContact", "mujoco_contact"]
+__all__ = [
+    "DirectionResult",
+    "HydroelasticCheck",
+    "MujocoContact",
+    "hydroelastic_check",
+    "mujoco_contact",
+]
