@@ -10,6 +10,7 @@ from measurements (:mod:`fixplan.motion`).
 The package is layered; each subpackage imports only from those below it::
 
     io/        problem, push and measurement files, reports, figures, command line
+    design/    sweeps of a problem's inputs, solved in parallel (Dask)
     motion/    pushing, pivoting, sliding dynamics, fits and slip-onset updates of limit surfaces
     planner/   problems -> stacked convex problem -> verified plans, motions, certificates
     models/    friction models (ellipsoid family, cones, pyramids, exact) and compare
@@ -53,9 +54,11 @@ _EXPORTS = {
 }
 _MODULES = {
     "compare": "fixplan.models.compare",
+    "design": "fixplan.design",
     "models": "fixplan.models",
     "motion": "fixplan.motion",
     "pressure": "fixplan.surface.pressure",
+    "sweep": "fixplan.io.sweep",
 }
 
 __all__ = [
@@ -77,11 +80,13 @@ __all__ = [
     "Screw",
     "__version__",
     "compare",
+    "design",
     "load_problem",
     "models",
     "motion",
     "pressure",
     "solve",
+    "sweep",
 ]
 
 
