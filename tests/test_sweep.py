@@ -34,7 +34,7 @@ def client():
     distributed = pytest.importorskip("distributed")
     with (
         distributed.LocalCluster(
-            n_workers=2, processes=True, threads_per_worker=1, dashboard_address=None
+            n_workers=2, processes=True, threads_per_worker=1, dashboard_address=":0"
         ) as cluster,
         distributed.Client(cluster) as client,
     ):
@@ -152,6 +152,19 @@ def test_the_command_line_writes_tables_and_figures(tmp_path, capsys):
     assert "--resume" in capsys.readouterr().err
     assert main([*argv, "--resume", str(out / "sweep.csv")]) == EXIT_OK
     assert "status     invalid input 2, optimal 2" in capsys.readouterr().out
+
+
+def test_the_command_line_sends_the_cases_to_an_existing_scheduler(client, tmp_path, capsys):
+    address = client.scheduler.address
+    argv = ["sweep", str(FIXTURE), "--vary", "contacts[6].mu=0.2:0.3:3", "--out",
+            str(tmp_path / "out"), "--scheduler", address, "--json"]  # fmt: skip
+    assert main(argv) == EXIT_OK
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["where"] == f"on {address}"
+    assert summary["statuses"] == {"optimal": 3}
+    serial = fixplan.sweep.run(FIXTURE, "contacts[6].mu=0.2:0.3:3", client=SERIAL)
+    table = read_table(tmp_path / "out" / "sweep.csv")
+    assert table.drop(columns="solve_time").equals(serial.drop(columns="solve_time"))
 
 
 @pytest.mark.parametrize(

@@ -127,6 +127,8 @@ def run_cases(
         )
     if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1:
         raise InvalidArgumentError(f"chunk_size must be a positive integer, got {chunk_size!r}")
+    if client is not None and workers is not None:
+        raise InvalidArgumentError("workers is for the default local cluster; give no client")
     chunks = _chunks(cases, chunk_size)
     if isinstance(client, str) and client == SERIAL:
         results = (solve_chunk(source, chunk) for chunk in chunks)
@@ -139,8 +141,8 @@ def run_cases(
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise InvalidArgumentError(f"workers must be a positive integer, got {workers!r}")
     with (
-        LocalCluster(
-            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None
+        LocalCluster(  # its web server on a free port: several sweeps may run side by side
+            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0"
         ) as cluster,
         Client(cluster) as local,
     ):

@@ -632,8 +632,10 @@ def _run_sweep(args: argparse.Namespace) -> tuple[int, str]:
     from fixplan.io.sweep_figures import write_sweep_figures
     from fixplan.io.sweep_table import write_tables
 
-    if not args.quiet and not args.verbose:
-        logging.getLogger("distributed").setLevel(logging.ERROR)
+    if not args.verbose:
+        import distributed  # noqa: F401 - sets its loggers' levels when first imported
+
+        logging.getLogger("distributed").setLevel(logging.ERROR)  # no cluster chatter
     cases = cases_of(args.vary, method=args.method, samples=args.samples, seed=args.seed)
     try:
         FileCases.read(args.file, list(cases.columns), objective=args.objective)
@@ -650,7 +652,8 @@ def _run_sweep(args: argparse.Namespace) -> tuple[int, str]:
     log.info("sweeping %s: %d cases %s", args.file, len(cases), where)
     try:
         table = run(
-            args.file, cases, client=client, table=table_path, resume=args.resume,
+            args.file, cases, client=client, workers=args.workers if client is None else None,
+            table=table_path, resume=args.resume,
             chunk_size=CHUNK_SIZE if args.chunk_size is None else args.chunk_size,
             progress=_Progress("sweeping", not args.quiet),
         )  # fmt: skip
