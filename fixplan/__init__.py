@@ -10,7 +10,8 @@ from measurements (:mod:`fixplan.motion`).
 The package is layered; each subpackage imports only from those below it::
 
     io/        problem, push and measurement files, reports, figures, command line
-    design/    layout search over candidate contacts (``fixplan.layout``)
+    design/    layout search over candidate contacts (``fixplan.layout``), sweeps of a
+               problem's inputs solved in parallel (Dask)
     motion/    pushing, pivoting, sliding dynamics, fits and slip-onset updates of limit surfaces
     planner/   problems -> stacked convex problem -> verified plans, motions, certificates
     models/    friction models (ellipsoid family, cones, pyramids, exact) and compare
@@ -54,10 +55,12 @@ _EXPORTS = {
 }
 _MODULES = {
     "compare": "fixplan.models.compare",
+    "design": "fixplan.design",
     "layout": "fixplan.design.api",
     "models": "fixplan.models",
     "motion": "fixplan.motion",
     "pressure": "fixplan.surface.pressure",
+    "sweep": "fixplan.io.sweep",
 }
 
 __all__ = [
@@ -79,12 +82,14 @@ __all__ = [
     "Screw",
     "__version__",
     "compare",
+    "design",
     "layout",
     "load_problem",
     "models",
     "motion",
     "pressure",
     "solve",
+    "sweep",
 ]
 
 

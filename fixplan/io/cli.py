@@ -256,7 +256,44 @@ def _build_parser() -> argparse.ArgumentParser:
     validate.add_argument("--margin", type=float, default=0.1,
                           help="scale the forces by 1 ± this (default 0.1)")  # fmt: skip
     validate.add_argument("--report", type=Path, metavar="DIR", help="write a report folder")
+    _sweep_parser(commands)
     return parser
+
+
+def _sweep_parser(commands) -> None:
+    sweep = _subcommand(
+        commands, "sweep", "solve a problem file for many values of its inputs, in parallel (Dask)",
+        "fixplan sweep problems/fixture-321.toml --vary contacts[7].position[0]=-0.05:0.05:11 "
+        "--vary defaults.mu=0.15:0.35:5 --out sweep/",
+        _run_sweep,
+    )  # fmt: skip
+    sweep.add_argument("file", type=Path, help="problem file (TOML)")
+    sweep.add_argument(
+        "--vary", action="append", required=True, metavar="KEY=START:STOP:COUNT",
+        help="a number of the file at a key path (contacts[1].mu, body.mass, loads[0].force[2]) "
+        "from START to STOP; COUNT values on a grid (leave :COUNT out with --method lhs); repeat "
+        "for more keys",
+    )  # fmt: skip
+    sweep.add_argument("--out", type=Path, required=True, metavar="DIR",
+                       help="folder of sweep.csv, sweep.parquet and figures/")  # fmt: skip
+    sweep.add_argument("--method", choices=("grid", "lhs"), default="grid",
+                       help="Cartesian grid or Latin hypercube (default %(default)s)")  # fmt: skip
+    sweep.add_argument("--samples", type=int, metavar="N", help="cases of a Latin hypercube")
+    sweep.add_argument("--seed", type=int, default=0, help="seed of a Latin hypercube")
+    where = sweep.add_mutually_exclusive_group()
+    where.add_argument(
+        "--workers", type=int, metavar="N",
+        help="worker processes of a local Dask cluster (default: one per core; 0: solve in this "
+        "process without Dask)",
+    )  # fmt: skip
+    where.add_argument("--scheduler", metavar="ADDRESS",
+                       help="an existing Dask cluster's scheduler, e.g. tcp://host:8786")  # fmt: skip
+    sweep.add_argument("--resume", type=Path, metavar="TABLE",
+                       help="keep the cases of this earlier table of the sweep (CSV or Parquet) "
+                       "and solve only the others")  # fmt: skip
+    sweep.add_argument("--chunk-size", type=int, metavar="N",
+                       help="cases per Dask task (default 16; keep it when resuming)")  # fmt: skip
+    _objective_option(sweep)
 
 
 class _Stopwatch:
@@ -743,6 +780,128 @@ def _run_fit(args: argparse.Namespace) -> tuple[int, str]:
     if args.json:
         return EXIT_OK, _json(summary)
     return EXIT_OK, "\n".join(describe_fit(summary))
+
+
+# -- sweep ---------------------------------------------------------------------------------------
+
+
+def _sweep_client(args: argparse.Namespace):
+    """The Dask client of ``--scheduler`` or ``--workers`` (``None``: a local cluster)."""
+    from fixplan.design import SERIAL
+
+    if args.scheduler is not None:
+        from distributed import Client
+
+        try:
+            return Client(args.scheduler, timeout=30)
+        except (OSError, ValueError, TypeError) as exc:
+            raise InvalidArgumentError(
+                f"--scheduler {args.scheduler}: cannot connect to a Dask scheduler there: {exc}"
+            ) from None
+    if args.workers is not None and args.workers < 0:
+        raise InvalidArgumentError(f"--workers must be 0 or more, got {args.workers}")
+    return SERIAL if args.workers == 0 else None
+
+
+def _sweep_table(args: argparse.Namespace) -> Path:
+    """Where the rows stream to; refuses to overwrite an earlier sweep not being resumed."""
+    _check_output_folder(args.out, "--out")
+    table = args.out / "sweep.csv"
+    if table.exists() and args.resume is None:
+        raise InvalidArgumentError(
+            f"--out {args.out}: holds a sweep already; continue it with --resume {table}, or "
+            "choose another folder"
+        )
+    if args.resume is not None and not args.resume.is_file():
+        raise InvalidArgumentError(f"--resume {args.resume}: no such file")
+    return table
+
+
+def _run_sweep(args: argparse.Namespace) -> tuple[int, str]:
+    from fixplan.design import CHUNK_SIZE, SERIAL
+    from fixplan.io.key_path import KeyPathError
+    from fixplan.io.sweep import FileCases, cases_of, run
+    from fixplan.io.sweep_figures import write_sweep_figures
+    from fixplan.io.sweep_table import write_tables
+
+    if not args.verbose:
+        import distributed  # noqa: F401 - sets its loggers' levels when first imported
+
+        logging.getLogger("distributed").setLevel(logging.ERROR)  # no cluster chatter
+    cases = cases_of(args.vary, method=args.method, samples=args.samples, seed=args.seed)
+    try:
+        FileCases.read(args.file, list(cases.columns), objective=args.objective)
+    except KeyPathError as exc:
+        raise InvalidArgumentError(f"--vary {exc} (in {args.file})") from None
+    table_path = _sweep_table(args)
+    args.out.mkdir(parents=True, exist_ok=True)
+    client = _sweep_client(args)
+    where = (
+        "in this process" if client == SERIAL
+        else f"on {args.scheduler}" if args.scheduler is not None
+        else f"on a local Dask cluster of {args.workers or os.cpu_count()} workers"
+    )  # fmt: skip
+    log.info("sweeping %s: %d cases %s", args.file, len(cases), where)
+    try:
+        table = run(
+            args.file, cases, client=client, workers=args.workers if client is None else None,
+            table=table_path, resume=args.resume,
+            chunk_size=CHUNK_SIZE if args.chunk_size is None else args.chunk_size,
+            progress=_Progress("sweeping", not args.quiet),
+        )  # fmt: skip
+    finally:
+        if client not in (None, SERIAL):
+            client.close()
+    written = write_tables(args.out, table)
+    problem_file = _load(args.file, objective=args.objective)
+    figures = write_sweep_figures(args.out / "figures", table, list(cases.columns),
+                                  problem_file.problem.objective)  # fmt: skip
+    summary = _sweep_summary(args, table, len(cases.columns), where)
+    summary["written"] = [str(path) for path in (*written, *figures)]
+    if args.json:
+        return EXIT_OK, _json(summary)
+    return EXIT_OK, "\n".join(_describe_sweep(summary))
+
+
+def _sweep_summary(args: argparse.Namespace, table, keys: int, where: str) -> dict:
+    """The ``--json`` document of a sweep: counts by status, the extreme cases, the files."""
+    solved = table[table["status"] == "optimal"]
+    summary = {
+        "file": str(args.file),
+        "cases": len(table),
+        "keys": list(table.columns[1 : 1 + keys]),
+        "method": args.method,
+        "where": where,
+        "statuses": {str(k): int(v) for k, v in sorted(table["status"].value_counts().items())},
+    }
+    if len(solved):
+        lowest = solved.loc[solved["objective_value"].idxmin()]
+        weakest = solved.loc[solved["safety_factor"].idxmin()]
+        summary["objective_range"] = [float(solved["objective_value"].min()),
+                                      float(solved["objective_value"].max())]  # fmt: skip
+        summary["lowest_objective_case"] = int(lowest["case"])
+        summary["smallest_safety_factor"] = float(weakest["safety_factor"])
+        summary["smallest_safety_factor_case"] = int(weakest["case"])
+    return summary
+
+
+def _describe_sweep(summary: dict) -> list[str]:
+    statuses = ", ".join(f"{status} {count}" for status, count in summary["statuses"].items())
+    lines = [
+        f"sweep      {summary['file']}: {summary['cases']} cases ({summary['method']} over "
+        f"{', '.join(summary['keys'])}), {summary['where']}",
+        f"status     {statuses}",
+    ]
+    if "objective_range" in summary:
+        low, high = summary["objective_range"]
+        lines += [
+            f"objective  {_number(low)} to {_number(high)} (lowest: case "
+            f"{summary['lowest_objective_case']})",
+            f"safety     smallest factor {_number(summary['smallest_safety_factor'])} (case "
+            f"{summary['smallest_safety_factor_case']})",
+        ]
+    lines += [f"wrote      {path}" for path in summary["written"]]
+    return lines
 
 
 # -- check ---------------------------------------------------------------------------------------

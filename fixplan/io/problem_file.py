@@ -361,6 +361,30 @@ def load_problem(
     )
 
 
+def problem_from_document(
+    document: dict,
+    path: str | os.PathLike[str],
+    *,
+    model: str | None = None,
+    objective: str | None = None,
+) -> Problem:
+    """The problem of a parsed problem file (the dict ``tomllib`` gives), checked exactly as
+    :func:`load_problem` checks a file's; ``path`` names it in messages and its folder is where
+    relative paths (meshes, grids, fits) start. Sweeps vary a document and read each case so.
+
+    Raises
+    ------
+    ProblemFileError
+        The document breaks the schema; lists every issue.
+    """
+    path = Path(path)
+    reader = _Reader(folder=path.parent, model=model, objective=objective)
+    _, _, problem = reader.document(document)
+    if reader.issues or problem is None:
+        raise ProblemFileError(path, reader.issues)
+    return problem
+
+
 def check_problem(
     path: str | os.PathLike[str], *, model: str | None = None, objective: str | None = None
 ) -> ProblemFile:
@@ -879,4 +903,11 @@ def _active_force(table: Table, key: str, role: str | None) -> float | None:
     return table.get(key, _FORCE)
 
 
-__all__ = ["Issue", "ProblemFile", "ProblemFileError", "check_problem", "load_problem"]
+__all__ = [
+    "Issue",
+    "ProblemFile",
+    "ProblemFileError",
+    "check_problem",
+    "load_problem",
+    "problem_from_document",
+]
