@@ -44,6 +44,13 @@ END_RTOL = 1e-6
 END_ATOL = 1e-7
 #: Multiples this far (relative) inside or outside a reported end are decidedly (not) held.
 PROBE_RTOL = 1e-6
+def probe_step(k: float) -> float:
+    """How far beyond an interval end at ``k`` a probe must lie to be decided: ``PROBE_RTOL`` of
+    it, and at least the ends' absolute agreement ten times over (a solver's absolute error in
+    a small multiple is relatively large)."""
+    return max(PROBE_RTOL * k, 10 * END_ATOL)
+
+
 #: Examples whose task load (k = 1) lies this close (relative) to an end of the reference
 #: interval are skipped: there ``held`` (which allows HELD_RTOL) and exact feasibility may differ.
 EDGE_RTOL = 10 * HELD_RTOL
@@ -345,12 +352,12 @@ def test_random_grasps_are_held_exactly_where_the_reference_holds_them(problem):
     low, high = plan.held_intervals["task"]
     assert_same_interval((low, high), expected)
     top = min(high, MAX_SAFETY_FACTOR)
-    assume(top - low > 10 * PROBE_RTOL * top)  # not a single point (probes would cross)
-    probes = {low * (1 + PROBE_RTOL): True, top * (1 - PROBE_RTOL): True}
-    if low > PROBE_RTOL:
-        probes[low * (1 - PROBE_RTOL)] = False
+    assume(top - low > 10 * probe_step(top))  # not a single point (probes would cross)
+    probes = {low + probe_step(low): True, top - probe_step(top): True}
+    if low > probe_step(low):
+        probes[low - probe_step(low)] = False
     if math.isfinite(high):
-        probes[high * (1 + PROBE_RTOL)] = False
+        probes[high + probe_step(high)] = False
     if min(abs(0.5 - low), abs(0.5 - top)) > EDGE_RTOL:
         probes[0.5] = low <= 0.5 <= high
     for k, held in probes.items():
