@@ -44,6 +44,8 @@ END_RTOL = 1e-6
 END_ATOL = 1e-7
 #: Multiples this far (relative) inside or outside a reported end are decidedly (not) held.
 PROBE_RTOL = 1e-6
+
+
 def probe_step(k: float) -> float:
     """How far beyond an interval end at ``k`` a probe must lie to be decided: ``PROBE_RTOL`` of
     it, and at least the ends' absolute agreement ten times over (a solver's absolute error in
