@@ -355,4 +355,7 @@ def assign(parameter: cp.Parameter, value) -> None:
     """Set ``parameter`` to ``value`` (broadcast to its shape) without cvxpy's validation,
     which costs more than a direct re-solve: the planner's values are checked where they come
     from (loads, given forces >= 0, multiples)."""
-    parameter.save_value(np.broadcast_to(np.asarray(value, dtype=float), parameter.shape).copy())
+    array = np.asarray(value, dtype=float)
+    if array.shape != parameter.shape:
+        array = np.broadcast_to(array, parameter.shape)
+    parameter.save_value(np.array(array))  # a copy: the caller may change its array
