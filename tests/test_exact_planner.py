@@ -194,3 +194,20 @@ def test_the_impending_motion_of_each_pinching_finger_is_the_normal_at_its_load(
         sliding = surface.motion(plan.contact_wrenches[i, 0, 1:] / plan.normal_forces[i, 0])
         a, b = twists[i] * scale, sliding * scale
         assert np.dot(a, b) / (np.linalg.norm(a) * np.linalg.norm(b)) > 1.0 - 1e-6
+
+
+def test_the_uses_kept_from_the_last_cutting_round_are_those_of_the_final_loads():
+    """Verification and the analysis take the exact contacts' friction use from the last round
+    of cuts instead of asking the exact surfaces again: it must be that of the final loads."""
+    planner = Planner(pinch(Load(name="hold", force=[0, 0, -8.0], point=[0.01, 0, 0],
+                                 torque=[0, 0.1, 0])))  # fmt: skip
+    plan = planner.solve()
+    assert plan.status == "optimal"
+    wrenches = planner.problem.task_wrenches()
+    forces = {i: plan.normal_forces[i, 0] for i in range(2)}
+    result = planner._runner.run("check", wrenches, forces)
+    known = result["known_use"]
+    noise = 1e-9 * float(np.abs(result["normal"]).max())
+    asked = planner.friction_use(result["friction"], result["normal"], noise=noise)
+    assert np.all(np.isfinite(known))
+    np.testing.assert_allclose(known, asked, rtol=1e-12)

@@ -58,3 +58,24 @@ def test_the_stacked_use_is_each_models_own_use_for_every_contact_and_case():
     finite = np.isfinite(expected)
     np.testing.assert_allclose(got[finite], expected[finite], rtol=1e-12, atol=1e-15)
     assert np.isinf(got[-1, 6:]).all()  # the frictionless contact cannot carry a load
+
+
+def test_known_uses_replace_the_one_by_one_queries_where_given():
+    """The uses the cutting rounds computed are taken as they are; NaN entries are asked."""
+    models = _models()
+    dims = np.cumsum([0] + [m.load_dimension for m in models])
+    slices = [slice(a, b) for a, b in itertools.pairwise(dims)]
+    rng = np.random.default_rng(4)
+    friction = rng.normal(size=(dims[-1], 6)) * 0.3
+    normal = rng.uniform(0.5, 2.0, size=(len(models), 6))
+    exact = 6  # the Exact model of _models(), asked one by one
+    known = np.full(normal.shape, np.nan)
+    known[exact, :3] = 0.25  # a value no query of these loads gives
+    use = FrictionUse(models, slices)
+    got = use(friction, normal, noise=NOISE, known=known)
+    asked = use(friction, normal, noise=NOISE)
+    np.testing.assert_array_equal(got[exact, :3], 0.25)
+    np.testing.assert_array_equal(got[exact, 3:], asked[exact, 3:])
+    mask = np.ones(len(models), dtype=bool)
+    mask[exact] = False
+    np.testing.assert_array_equal(got[mask], asked[mask])  # other contacts ignore it

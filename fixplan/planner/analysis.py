@@ -58,7 +58,8 @@ def analyse_cases(
         twist = twist if wrenches[:, j] @ twist >= 0.0 else -twist
         motions[name] = Screw.from_twist(twist, length_scale)
     noise = FRICTION_SET_RTOL * max(float(np.abs(normal).max()), 1e-12)
-    utilisation = np.minimum(friction_use(friction, normal, noise=noise), 1.0)
+    known = highest.get("known_use")
+    utilisation = np.minimum(friction_use(friction, normal, noise=noise, known=known), 1.0)
     # Cases tied with the smallest margin (within solver accuracy): the first.
     critical = int(np.flatnonzero(margin <= margin.min() * (1.0 + HELD_RTOL))[0])
     return {

@@ -107,6 +107,10 @@ class CutPool:
         self._planes = np.zeros((3, CUT_SLOTS, count, cases))
         self._used = np.full((CUT_SLOTS, count, cases), -1, dtype=np.int64)
         self._round = 0
+        #: ``(C, K)`` friction use ``1 / s`` of every exact contact's load in the last solve that
+        #: :meth:`add_cuts` checked (NaN for other contacts and unpressed ones): the solve's
+        #: final loads, whose exact safety factors verification need not ask for again.
+        self.use = np.full((normal.shape[0], cases), np.nan)
         self._parameters = [
             cp.Parameter((CUT_SLOTS * count, cases), name=f"cut_{axis}", value=np.zeros(
                 (CUT_SLOTS * count, cases)))
@@ -161,6 +165,7 @@ class CutPool:
         twists = self.motion_twists()  # (E, K, 3)
         noise = FRICTION_SET_RTOL * max(float(np.abs(normal).max(initial=0.0)), 1e-300)
         worst = -np.inf
+        self.use[:] = np.nan
         for e, model in enumerate(self._models):
             cases = np.flatnonzero(forces[e] > noise)
             per_unit = loads[:, e, cases].T / forces[e, cases, None]
@@ -169,6 +174,7 @@ class CutPool:
             if cases.size == 0:
                 continue
             planes, excess = model.cut(per_unit)
+            self.use[self._contacts[e], cases] = 1.0 + excess
             worst = max(worst, float(excess.max()))
             cut = excess > EXACT_CUT_RTOL
             cases, planes, per_unit = cases[cut], planes[cut], per_unit[cut]

@@ -63,10 +63,22 @@ class FrictionUse:
         out[self._fallback] = np.nan
         return out
 
-    def __call__(self, friction: np.ndarray, normal: np.ndarray, *, noise: float) -> np.ndarray:
+    def __call__(
+        self,
+        friction: np.ndarray,
+        normal: np.ndarray,
+        *,
+        noise: float,
+        known: np.ndarray | None = None,
+    ) -> np.ndarray:
         """Use ``(C, K)`` of loads ``friction`` ``(D, K)`` at normal forces ``normal`` ``(C, K)``
         [N]: 1 on the limit; 0 where the load and the normal force are within ``noise`` [N] of
-        0 (solver noise); ``inf`` for a load on a contact without normal force or friction."""
+        0 (solver noise); ``inf`` for a load on a contact without normal force or friction.
+
+        ``known`` ``(C, K)`` holds uses already computed for these very loads (the cutting
+        rounds of exact models ask the exact surfaces); where it is finite, the contacts asked
+        one by one are not asked again.
+        """
         use = np.zeros(normal.shape)
         carries = np.maximum.reduceat(np.abs(friction), self._starts, axis=0) > noise
         pressed = carries & (normal > noise)
@@ -75,9 +87,14 @@ class FrictionUse:
             ratio = self.gauges(friction) / normal
         use[pressed] = ratio[pressed]
         for i in self._fallback:
-            if pressed[i].any():
-                use[i, pressed[i]] = friction_use(
-                    self._models[i], friction[self._slices[i]].T[pressed[i]], normal[i, pressed[i]]
+            ask = pressed[i]
+            if known is not None:
+                found = ask & np.isfinite(known[i])
+                use[i, found] = known[i, found]
+                ask = ask & ~found
+            if ask.any():
+                use[i, ask] = friction_use(
+                    self._models[i], friction[self._slices[i]].T[ask], normal[i, ask]
                 )
         return use
 

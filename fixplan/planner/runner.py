@@ -71,8 +71,10 @@ class Runner:
     """Compiled stacked problems of one :class:`~fixplan.Problem`, and their solves.
 
     A result is a dict with ``status``, ``solver``, ``warnings`` and, when solved, ``normal``
-    ``(C, K)``, ``friction`` ``(D, K)``, ``scale`` ``(K,)`` and ``dual`` ``(6, K)`` (the
-    equilibrium multipliers: the twist of impending motion per case).
+    ``(C, K)``, ``friction`` ``(D, K)``, ``scale`` ``(K,)``, ``dual`` ``(6, K)`` (the
+    equilibrium multipliers: the twist of impending motion per case) and, with exact models,
+    ``known_use`` ``(C, K)`` (their loads' friction use from the last round of cuts, NaN
+    elsewhere).
     """
 
     def __init__(
@@ -182,6 +184,8 @@ class Runner:
         result = {"status": status, "solver": solver, "warnings": notes}
         if status in ("optimal", "inaccurate"):
             result.update(_values(stacked))
+            if stacked.cuts is not None:
+                result["known_use"] = stacked.cuts.use.copy()
         if status in ("optimal", "inaccurate", "infeasible"):
             dual = stacked.balance.dual_value
             result["dual"] = None if dual is None else np.asarray(dual, dtype=float)
@@ -293,7 +297,7 @@ def _merge(results: list[tuple[dict, int]]) -> dict:
         "warnings": [note for r, _ in results for note in r["warnings"]],
     }
     trimmed = [_trim(r, used) for r, used in results]
-    for key in ("normal", "friction", "scale", "dual"):
+    for key in ("normal", "friction", "scale", "dual", "known_use"):
         parts = [r.get(key) for r in trimmed]
         if status == "infeasible" and key == "dual":
             parts = [
@@ -308,7 +312,7 @@ def _merge(results: list[tuple[dict, int]]) -> dict:
 def _trim(result: dict, used: int) -> dict:
     """Drop the padding columns of a block's result."""
     trimmed = dict(result)
-    for key in ("normal", "friction", "dual"):
+    for key in ("normal", "friction", "dual", "known_use"):
         if trimmed.get(key) is not None:
             trimmed[key] = trimmed[key][:, :used]
     if "scale" in trimmed:

@@ -76,17 +76,19 @@ class Verifier:
                     f"{ratio[worst] * size[worst]:.3g} {unit}, over {EQUILIBRIUM_RTOL:g} of the "
                     f"wrenches involved ({size[worst]:.3g} {unit})"
                 )
-        return relative, problems + self._friction_problems(normal, friction)
+        known = answer.get("known_use")
+        return relative, problems + self._friction_problems(normal, friction, known)
 
-    def _friction_problems(self, normal: np.ndarray, friction: np.ndarray) -> list[str]:
-        """Pulling contacts, friction without normal force and friction outside its set."""
+    def _friction_problems(self, normal, friction, known) -> list[str]:
+        """Pulling contacts, friction without normal force and friction outside its set
+        (``known``: the uses already computed for some contacts, see :class:`FrictionUse`)."""
         scale_force = max(float(np.abs(normal).max()), 1e-12)
         noise = FRICTION_SET_RTOL * scale_force
         problems = [
             f"contact {self._names[i]!r} pulls: normal force {normal[i].min():.3g} N"
             for i in np.flatnonzero((normal < -noise).any(axis=1))
         ]
-        use = self._use(friction, normal, noise=noise)
+        use = self._use(friction, normal, noise=noise, known=known)
         pressed = normal > noise
         problems += [
             f"contact {self._names[i]!r} carries friction without normal force"
