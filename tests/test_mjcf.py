@@ -84,10 +84,6 @@ def test_contact_names_with_quotes_and_brackets_make_a_valid_scene(plans):
     odd = {c.name: f'{c.name} "x" <&>' for c in problem.contacts}
     contacts = tuple(dataclasses.replace(c, name=odd[c.name]) for c in problem.contacts)
     renamed = dataclasses.replace(problem, contacts=contacts)
-    forces = {odd[name]: force for name, force in scene_forces(problem, plan).items()}
+    forces = {odd[name]: force for name, force in to_mjcf(problem, plan).forces.items()}
     model = mujoco.MjModel.from_xml_string(to_mjcf(renamed, forces=forces).xml)
     assert model.geom(f"tip-{contacts[0].name}").id >= 0
-
-
-def scene_forces(problem, plan) -> dict:
-    return to_mjcf(problem, plan).forces
