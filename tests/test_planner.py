@@ -254,6 +254,28 @@ def test_verification_flags_a_pulling_contact_and_friction_without_normal_force(
     assert any("'right' carries friction without normal force" in p for p in problems)
 
 
+def test_verification_measures_the_equilibrium_residual_against_the_wrench_terms():
+    load = off_axis_load(offset=0.0)
+    planner = Planner(pinch("point-cone", load=load))
+    normal = np.array([[10.0, 10.0], [10.0, 10.0]])
+    friction = np.zeros((4, 2))  # no friction: nothing holds the weight
+    wrenches = np.column_stack([load.wrench, 2.0 * load.wrench])
+    answer = {"normal": normal, "friction": friction, "scale": np.array([1.0, 0.5])}
+    relative, problems = Verifier(planner.problem, planner.layout, planner.friction_use, 0.02)(
+        answer, wrenches
+    )
+    # Straight from the definition: the residual's largest force over the largest sum of the
+    # force terms' sizes (opposed fingers cancel in the sums, not in the sizes); case 2 is the
+    # same as case 1.
+    layout, gravity = planner.layout, planner.problem.body.weight_wrench[:, None]
+    task = wrenches * answer["scale"]
+    residual = layout.normal_map @ normal + task + gravity
+    sizes = np.abs(layout.normal_map) @ np.abs(normal) + np.abs(task) + np.abs(gravity)
+    expected = np.abs(residual[:3, 0]).max() / sizes[:3, 0].max()
+    assert expected > 0.1
+    assert relative == pytest.approx(expected, rel=1e-12)
+    assert any(p.startswith("equilibrium residual of load case 1") for p in problems)
+
 def test_three_point_contact_set_surface_equals_the_planar_limit_surface_of_the_points():
     xy = np.array([[0.03, 0.0], [-0.02, 0.025], [-0.02, -0.03]])
     forces = np.array([4.0, 8.0, 6.0])

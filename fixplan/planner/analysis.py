@@ -22,23 +22,21 @@ import numpy as np
 from fixplan.planner.friction_use import FrictionUse
 from fixplan.planner.problem import Problem
 from fixplan.planner.screw import Screw
-from fixplan.planner.stacking import ContactLayout
 from fixplan.tolerances import FRICTION_SET_RTOL, HELD_RTOL, MAX_SAFETY_FACTOR, MULTIPLE_ATOL
 
 
 def analyse_cases(
     problem: Problem,
-    layout: ContactLayout,
     friction_use: FrictionUse,
+    staying: StayingInContact,
     highest: dict,
     lowest: dict | None,
     wrenches: np.ndarray,
-    decided: np.ndarray,
     length_scale: float,
 ) -> dict:
     """Plan fields from the maximising (``highest``) and minimising (``lowest``) fixed-force
-    solves of every load case; ``decided`` ``(C,)`` marks contacts whose normal force the solve
-    chose (their normal velocity is projected out of the motion)."""
+    solves of every load case; ``staying`` projects the motions onto those that keep the
+    contacts whose normal force the solve chose in contact."""
     names = tuple(load.name for load in problem.loads)
     k_max = np.maximum(highest["scale"], 0.0)  # the solver may return -1e-19 for 0
     k_max = np.where(k_max >= MAX_SAFETY_FACTOR * (1 - 1e-6), np.inf, k_max)
@@ -47,32 +45,28 @@ def analyse_cases(
     with np.errstate(divide="ignore"):
         margin = np.minimum(k_max, np.where(k_min > 0.0, 1.0 / k_min, np.inf))
     normal, friction, dual = highest["normal"], highest["friction"], highest.get("dual")
-    motions = {}
-    for j, name in enumerate(names):
-        twist = None if dual is None or not np.isfinite(k_max[j]) else dual[:, j]
-        if twist is not None and np.any(twist):
-            twist = keep_contact(twist, normal[:, j], decided, layout.normal_map, length_scale)
-        if twist is None or not np.any(twist):
-            motions[name] = None
-            continue
-        twist = twist if wrenches[:, j] @ twist >= 0.0 else -twist
-        motions[name] = Screw.from_twist(twist, length_scale)
+    motions = dict.fromkeys(names)
+    if dual is not None:
+        moving = np.flatnonzero(np.isfinite(k_max) & dual.any(axis=0))
+        twists = staying(dual[:, moving], normal[:, moving])
+        # Towards the task load: the dual's sign is the solver's choice.
+        twists *= np.where(np.sum(wrenches[:, moving] * twists, axis=0) >= 0.0, 1.0, -1.0)
+        for j, twist in zip(moving, twists.T, strict=True):
+            if twist.any():
+                motions[names[j]] = Screw.from_twist(twist, length_scale)
     noise = FRICTION_SET_RTOL * max(float(np.abs(normal).max()), 1e-12)
     known = highest.get("known_use")
     utilisation = np.minimum(friction_use(friction, normal, noise=noise, known=known), 1.0)
     # Cases tied with the smallest margin (within solver accuracy): the first.
     critical = int(np.flatnonzero(margin <= margin.min() * (1.0 + HELD_RTOL))[0])
+    held = (k_min <= 1.0 + HELD_RTOL) & (k_max >= 1.0 - HELD_RTOL)
     return {
-        "safety_factors": dict(zip(names, map(float, k_max), strict=True)),
+        "safety_factors": dict(zip(names, k_max.tolist(), strict=True)),
         "safety_factor": float(k_max.min()),
-        "held_intervals": {
-            name: (float(low), float(high))
-            for name, low, high in zip(names, k_min, k_max, strict=True)
-        },
-        "held": {
-            name: bool(low <= 1.0 + HELD_RTOL and high >= 1.0 - HELD_RTOL)
-            for name, low, high in zip(names, k_min, k_max, strict=True)
-        },
+        "held_intervals": dict(
+            zip(names, zip(k_min.tolist(), k_max.tolist(), strict=True), strict=True)
+        ),
+        "held": dict(zip(names, held.tolist(), strict=True)),
         "motions": motions,
         "utilisation": utilisation,
         "critical_load": names[critical],
@@ -80,28 +74,57 @@ def analyse_cases(
     }
 
 
-def keep_contact(
-    twist: np.ndarray,
-    normal_forces: np.ndarray,
-    decided: np.ndarray,
-    normal_map: np.ndarray,
-    length_scale: float,
-) -> np.ndarray:
-    """The twist nearest ``twist`` in which every pressed contact of ``decided`` stays in contact.
+class StayingInContact:
+    """Twists nearest given ones in which the pressed contacts of ``decided`` stay in contact.
 
     The normal velocity of the body at contact ``i`` is ``normal_map[:, i] · V``; it is
     projected out for the pressed decided contacts — unless that removes most of the motion
     (when they leave no sliding motion at all, one of them must lift off as it starts to slide);
-    then the dual twist itself, which lifts no contact into the body, is the answer.
+    then the dual twist itself, which lifts no contact into the body, is the answer. The
+    projection of each set of pressed contacts is computed once (an SVD) and kept.
+
+    Parameters
+    ----------
+    normal_map : array (6, C)
+        Body wrench of a unit normal force at each contact.
+    decided : array (C,) of bool
+        Contacts whose normal force the solve chose.
+    length_scale : float
+        The body's length scale [m]: sets the rank test of the contact normals.
     """
-    size = max(float(np.abs(normal_forces).max()), 1e-300)
-    pressed = np.flatnonzero(decided & (normal_forces > FRICTION_SET_RTOL * size))
-    if pressed.size == 0:
-        return twist
-    rows = normal_map[:, pressed].T
-    _, singular, basis = np.linalg.svd(rows)
-    rank = int(np.sum(singular > 1e-9 * length_scale))
-    free = basis[rank:]
-    projected = free.T @ (free @ twist)
-    kept = np.linalg.norm(projected) >= 0.5 * np.linalg.norm(twist)
-    return projected if kept else twist
+
+    def __init__(self, normal_map: np.ndarray, decided: np.ndarray, length_scale: float):
+        self._normal_map = np.asarray(normal_map, dtype=float)
+        self._decided = np.asarray(decided, dtype=bool)
+        self._length_scale = float(length_scale)
+        self._projections: dict[bytes, np.ndarray | None] = {}
+
+    def __call__(self, twists: np.ndarray, normal_forces: np.ndarray) -> np.ndarray:
+        """The twists ``(6, K)`` kept in contact, at the normal forces ``(C, K)`` [N]."""
+        size = np.maximum(np.abs(normal_forces).max(axis=0, initial=0.0), 1e-300)
+        pressed = self._decided[:, None] & (normal_forces > FRICTION_SET_RTOL * size)
+        out = np.array(twists, dtype=float)
+        groups: dict[bytes, list[int]] = {}
+        for j, column in enumerate(pressed.T):
+            groups.setdefault(column.tobytes(), []).append(j)
+        for key, cases in groups.items():
+            projection = self._projection(key, pressed[:, cases[0]])
+            if projection is None:
+                continue
+            projected = projection @ out[:, cases]
+            kept = np.linalg.norm(projected, axis=0) >= 0.5 * np.linalg.norm(out[:, cases], axis=0)
+            out[:, np.asarray(cases)[kept]] = projected[:, kept]
+        return out
+
+    def _projection(self, key: bytes, pressed: np.ndarray) -> np.ndarray | None:
+        """The orthogonal projection ``(6, 6)`` onto the twists that move no contact of
+        ``pressed`` along its normal (``None`` for none pressed)."""
+        if key not in self._projections:
+            projection = None
+            if pressed.any():
+                _, singular, basis = np.linalg.svd(self._normal_map[:, pressed].T)
+                rank = int(np.sum(singular > 1e-9 * self._length_scale))
+                free = basis[rank:]
+                projection = free.T @ free
+            self._projections[key] = projection
+        return self._projections[key]

@@ -21,6 +21,10 @@ import scipy.sparse as sp
 #: Largest relative difference from cvxpy's own answer accepted when the direct path is built.
 AGREEMENT_RTOL = 1e-6
 
+#: Maps of the parameter vector up to this many entries are applied dense: a sparse product costs
+#: about 10 µs of overhead, as much as a dense one of this size.
+DENSE_MAX_ENTRIES = 20_000
+
 #: Clarabel's statuses of a problem without a feasible point.
 INFEASIBLE = ("PrimalInfeasible", "AlmostPrimalInfeasible")
 
@@ -147,16 +151,17 @@ class _Program:
         self._columns = [(p, program.param_id_to_col[p.id], p.size) for p in parameters]
         self._size = program.total_param_size + 1  # the last entry is the constant 1
         self._variables = program.x.size
-        self._q = sp.csr_array(program.q)
+        self._q = _for_products(sp.csr_array(program.q))
         program.reduced_A.cache()
-        self._a_map = sp.csr_array(program.reduced_A.reduced_mat)
+        a_map = sp.csr_array(program.reduced_A.reduced_mat)
         indices, indptr, shape = program.reduced_A.problem_data_index
         self._a_rows = np.asarray(indices)
         self._split = int(indptr[-2])  # entries of A; the rest are b's, in the last column
         self._a_shape = (int(shape[0]), int(shape[1]) - 1)
         self._a_indptr = np.asarray(indptr[:-1])
         #: Whether ``A`` does not depend on the parameters (only ``b`` and ``q`` change).
-        self.fixed_a = self._a_map[:, : self._size - 1][: self._split].nnz == 0
+        self.fixed_a = a_map[:, : self._size - 1][: self._split].nnz == 0
+        self._a_map = _for_products(a_map)
         if program.reduced_P is None or program.reduced_P.matrix_data is None:
             self.quadratic = sp.csc_matrix((self._variables, self._variables))
             self.parametric_p = False
@@ -193,6 +198,11 @@ class _Program:
         """Clarabel's ``A`` from its ``values``."""
         pattern = (self._a_rows[: self._split], self._a_indptr)
         return sp.csc_matrix((values, *pattern), shape=self._a_shape)
+
+
+def _for_products(matrix: sp.csr_array):
+    """``matrix`` as it is fastest to multiply: dense up to ``DENSE_MAX_ENTRIES`` entries."""
+    return matrix.toarray() if matrix.shape[0] * matrix.shape[1] <= DENSE_MAX_ENTRIES else matrix
 
 
 def _equality_rows(constraints) -> dict:

@@ -3,20 +3,19 @@
 Verification and the safety analysis ask this of every (contact, load case) after each solve. A
 model whose gauge is a sum of norms and maxima of linear maps of the load
 (:meth:`~fixplan.models.FrictionModel.gauge_terms`: ellipsoids, cones, pyramids, polytopes) is
-checked for all its cases in a few stacked sparse products; the others (exact, SDP and faceted
-models, frictionless contacts) are asked one by one through their ``safety_factor``.
+checked for all its cases in one compiled loop; the others (exact, SDP and faceted models,
+frictionless contacts) are asked one by one through their ``safety_factor``.
 """
 
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
 
 from fixplan.models.base import FrictionModel
+from fixplan.surface.point_kernel import compiled_scalar
 
-#: Stacked term matrices up to this many entries are kept dense (a sparse product costs about
-#: 10 µs of overhead, as much as a dense one of this size).
-DENSE_MAX_ENTRIES = 20_000
+#: Kinds of gauge terms, as the compiled loop numbers them.
+_KINDS = {"norm": 0, "max": 1}
 
 
 class FrictionUse:
@@ -33,35 +32,27 @@ class FrictionUse:
     def __init__(self, models, slices):
         self._models = tuple(models)
         self._slices = tuple(slices)
-        width = max((part.stop for part in self._slices), default=0)
-        blocks = {"norm": [], "max": []}
-        self._fallback = []
-        for i, (model, part) in enumerate(zip(self._models, self._slices, strict=True)):
+        self._starts = np.array([part.start for part in self._slices], dtype=np.intp)
+        self._stops = np.array([part.stop for part in self._slices], dtype=np.intp)
+        width = int(max((self._stops - self._starts).max(initial=0), 1))
+        self._asked = np.zeros(len(self._models), dtype=np.bool_)
+        rows, kinds, owners, first = [], [], [], [0]
+        for i, model in enumerate(self._models):
             terms = model.gauge_terms()
             if terms is None:
-                self._fallback.append(i)
+                self._asked[i] = True
                 continue
             for kind, matrix in terms:
-                placed = np.zeros((len(matrix), width))
-                placed[:, part] = matrix
-                blocks[kind].append((placed, i))
-        self._terms = {kind: _stacked(found, len(self._models)) for kind, found in blocks.items()}
-        self._starts = np.array([part.start for part in self._slices], dtype=np.intp)
-
-    def gauges(self, friction: np.ndarray) -> np.ndarray:
-        """Gauges ``(C, K)`` at unit normal force of the loads ``friction`` ``(D, K)``: NaN for
-        the contacts asked one by one."""
-        out = np.zeros((len(self._models), friction.shape[1]))
-        norm, largest = self._terms["norm"], self._terms["max"]
-        if norm is not None:
-            rows, starts, owners = norm
-            values = rows @ friction
-            out += owners @ np.sqrt(np.add.reduceat(values * values, starts, axis=0))
-        if largest is not None:
-            rows, starts, owners = largest
-            out += owners @ np.maximum.reduceat(rows @ friction, starts, axis=0)
-        out[self._fallback] = np.nan
-        return out
+                padded = np.zeros((len(matrix), width))
+                padded[:, : matrix.shape[1]] = matrix
+                rows.append(padded)
+                kinds.append(_KINDS[kind])
+                owners.append(i)
+                first.append(first[-1] + len(matrix))
+        self._rows = np.vstack(rows) if rows else np.zeros((0, width))
+        self._kinds = np.array(kinds, dtype=np.intp)
+        self._owners = np.array(owners, dtype=np.intp)
+        self._first = np.array(first, dtype=np.intp)
 
     def __call__(
         self,
@@ -79,15 +70,13 @@ class FrictionUse:
         rounds of exact models ask the exact surfaces); where it is finite, the contacts asked
         one by one are not asked again.
         """
-        use = np.zeros(normal.shape)
-        carries = np.maximum.reduceat(np.abs(friction), self._starts, axis=0) > noise
-        pressed = carries & (normal > noise)
-        use[carries & ~pressed] = np.inf
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = self.gauges(friction) / normal
-        use[pressed] = ratio[pressed]
-        for i in self._fallback:
-            ask = pressed[i]
+        friction = np.ascontiguousarray(friction, dtype=float)
+        normal = np.ascontiguousarray(normal, dtype=float)
+        use = np.empty(normal.shape)
+        _USES(friction, normal, float(noise), self._starts, self._stops, self._asked,
+              self._rows, self._kinds, self._owners, self._first, use)  # fmt: skip
+        for i in np.flatnonzero(self._asked):
+            ask = np.isnan(use[i])  # pressed and carrying a load
             if known is not None:
                 found = ask & np.isfinite(known[i])
                 use[i, found] = known[i, found]
@@ -108,18 +97,37 @@ def friction_use(model: FrictionModel, load: np.ndarray, normal_force: np.ndarra
         return 1.0 / safety
 
 
-def _stacked(found: list, contacts: int):
-    """The terms of one kind as stacked rows ``(R, D)``, the first row of each term and the map
-    ``(C, T)`` from terms to their contacts; ``None`` without terms."""
-    if not found:
-        return None
-    sizes = [len(placed) for placed, _ in found]
-    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
-    owners = sp.csr_array(
-        (np.ones(len(found)), ([owner for _, owner in found], np.arange(len(found)))),
-        shape=(contacts, len(found)),
-    )
-    rows = np.vstack([placed for placed, _ in found])
-    if rows.size <= DENSE_MAX_ENTRIES:  # small products are faster dense
-        return rows, starts, owners.toarray()
-    return sp.csr_array(rows), starts, owners
+def uses(
+    friction, normal, noise, starts, stops, asked, rows, kinds, owners, first, out
+):  # pragma: no cover - compiled
+    """:class:`FrictionUse` for the contacts with gauge terms, into ``out`` ``(C, K)``; NaN
+    where a contact of ``asked`` is pressed and carries a load (its model must be asked)."""
+    contacts, cases = normal.shape
+    gauge = np.zeros(contacts)
+    for k in range(cases):
+        gauge[:] = 0.0
+        for t in range(kinds.shape[0]):
+            owner = owners[t]
+            start, width = starts[owner], stops[owner] - starts[owner]
+            total = 0.0 if kinds[t] == 0 else -np.inf
+            for r in range(first[t], first[t + 1]):
+                value = 0.0
+                for d in range(width):
+                    value += rows[r, d] * friction[start + d, k]
+                total = total + value * value if kinds[t] == 0 else max(total, value)
+            gauge[owner] += np.sqrt(total) if kinds[t] == 0 else total
+        for c in range(contacts):
+            carries = False
+            for d in range(starts[c], stops[c]):
+                carries = carries or abs(friction[d, k]) > noise
+            if not carries:
+                out[c, k] = 0.0
+            elif normal[c, k] <= noise:
+                out[c, k] = np.inf
+            elif asked[c]:
+                out[c, k] = np.nan
+            else:
+                out[c, k] = gauge[c] / normal[c, k]
+
+
+_USES = compiled_scalar(uses)

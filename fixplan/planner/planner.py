@@ -27,7 +27,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from fixplan.errors import InvalidArgumentError
-from fixplan.planner.analysis import analyse_cases
+from fixplan.planner.analysis import StayingInContact, analyse_cases
 from fixplan.planner.certificate import certificate
 from fixplan.planner.contact_models import contact_model
 from fixplan.planner.friction_use import FrictionUse
@@ -88,6 +88,7 @@ class Planner:
         spread = np.linalg.norm(positions - problem.body.center_of_mass, axis=1)
         self.length_scale = float(max(spread.max(), 1e-3))
         self._passive = np.array([c.role in PASSIVE_ROLES for c in problem.contacts])
+        self._staying = StayingInContact(self.layout.normal_map, self._passive, self.length_scale)
         self._verify = Verifier(problem, self.layout, self.friction_use, self.length_scale)
         passive_map = self.layout.normal_map[:, self._passive]
         squeezable = np.zeros(len(problem.contacts), dtype=bool)
@@ -270,11 +271,8 @@ class Planner:
         lowest = self._lowest(wrenches, given, squeezed, progress, disabled)
         if lowest["status"] not in ("optimal", "inaccurate"):
             lowest = None
-        decided = self._passive.copy()
-        return analyse_cases(
-            self.problem, self.layout, self.friction_use, highest, lowest, wrenches, decided,
-            self.length_scale,
-        )  # fmt: skip
+        return analyse_cases(self.problem, self.friction_use, self._staying, highest, lowest,
+                             wrenches, self.length_scale)  # fmt: skip
 
     def _lowest(self, wrenches, given, squeezed, progress, disabled=None) -> dict:
         """The minimising fixed-force solve: ``scale`` holds ``k_min`` of every case.

@@ -293,7 +293,7 @@ class Load:
     @property
     def rotates(self) -> bool:
         """Whether the load has an angular velocity or acceleration (needs the body's inertia)."""
-        return bool(np.any(self.angular_velocity) or np.any(self.angular_acceleration))
+        return bool(self.angular_velocity.any() or self.angular_acceleration.any())
 
     @property
     def wrench(self) -> np.ndarray:
@@ -530,7 +530,7 @@ class Problem:
         columns = []
         for load in loads:
             wrench = load.wrench
-            if load.rotates or np.any(load.acceleration):
+            if load.rotates or load.acceleration.any():
                 if load.rotates and self.body.inertia is None:
                     raise ProblemError(
                         f"load {load.name!r} has an angular velocity or acceleration: the body "

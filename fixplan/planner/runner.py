@@ -40,7 +40,11 @@ SOLVERS = ("CLARABEL", "OSQP", "SCS")
 DPP_MAX_WORK = 5_000_000
 
 #: Load cases per compiled problem of the fixed-force objectives (their cases are independent).
-CASES_PER_BLOCK = 64
+#: Clarabel's time per case grows with the block, the Python work per block falls: `check` of
+#: 1,000 cases of benchmarks/bench_planner.py, blocks of 1 / 4 / 16 / 64 cases: fixture-321
+#: (pyramids) 2,276 / 2,359 / 1,728 / 1,195 cases/s; the ellipsoid fixture (blocks of 1 / 4 / 8
+#: / 64) 3,021 / 3,930 / 3,615 / 3,102 cases/s.
+CASES_PER_BLOCK = 4
 
 _FALLBACK = {"CLARABEL": "SCS", "SCS": "CLARABEL", "OSQP": "CLARABEL"}
 #: Clarabel's iterative refinement of the KKT solves is off: it takes about half of the solve

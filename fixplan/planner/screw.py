@@ -55,8 +55,8 @@ class Screw:
         v, omega = np.asarray(twist[:3], float), np.asarray(twist[3:], float)
         norm = np.sqrt(v @ v + (length_scale**2) * (omega @ omega))
         v, omega = v / norm, omega / norm
-        spin = float(np.linalg.norm(omega))
-        if spin * length_scale <= TRANSLATION_RTOL * np.linalg.norm(v):
+        spin = float(np.sqrt(omega @ omega))
+        if spin * length_scale <= TRANSLATION_RTOL * np.sqrt(v @ v):
             return cls(
                 twist=np.concatenate([v, np.zeros(3)]),
                 direction=v / np.linalg.norm(v),
@@ -65,7 +65,8 @@ class Screw:
                 length_scale=length_scale,
             )
         direction = omega / spin
-        point = np.cross(omega, v) / spin**2
+        (wx, wy, wz), (vx, vy, vz) = omega, v  # ω × v written out: np.cross costs more
+        point = np.array([wy * vz - wz * vy, wz * vx - wx * vz, wx * vy - wy * vx]) / spin**2
         pitch = float(omega @ v) / spin**2
         return cls(
             twist=np.concatenate([v, omega]),

@@ -7,6 +7,7 @@ import numpy as np
 from fixplan.planner.friction_use import FrictionUse
 from fixplan.planner.problem import Problem
 from fixplan.planner.stacking import ContactLayout
+from fixplan.surface.point_kernel import compiled_scalar
 from fixplan.tolerances import EQUILIBRIUM_RTOL, FRICTION_SET_RTOL
 
 
@@ -33,9 +34,10 @@ class Verifier:
         length_scale: float,
     ):
         self._names = [contact.name for contact in problem.contacts]
-        self._gravity = problem.body.weight_wrench[:, None]
-        self._maps = (layout.normal_map, layout.friction_map)
-        self._sizes = (np.abs(layout.normal_map), np.abs(layout.friction_map))
+        self._gravity = np.ascontiguousarray(problem.body.weight_wrench, dtype=float)
+        self._maps = tuple(
+            np.ascontiguousarray(m, dtype=float) for m in (layout.normal_map, layout.friction_map)
+        )
         self._use = friction_use
         self._length_scale = length_scale
 
@@ -48,34 +50,22 @@ class Verifier:
         may exceed its set by ``FRICTION_SET_RTOL`` of the largest normal force.
         """
         normal, friction, scale = answer["normal"], answer["friction"], answer["scale"]
-        normal_map, friction_map = self._maps
-        task = wrenches * scale
-        residual = normal_map @ normal + friction_map @ friction + task + self._gravity
-        # The size of every term, not of their sums: opposed contacts cancel in the sums.
-        normal_size, friction_size = self._sizes
-        magnitude = (
-            normal_size @ np.abs(normal)
-            + friction_size @ np.abs(friction)
-            + np.abs(task)
-            + np.abs(self._gravity)
-        )
-        force_size = np.maximum(magnitude[:3].max(axis=0), 1e-12)
-        moment_size = np.maximum(magnitude[3:].max(axis=0), force_size * self._length_scale)
+        sizes = np.empty((2, normal.shape[1]))
+        ratios = np.empty((2, normal.shape[1]))
+        _EQUILIBRIUM(*self._maps, np.ascontiguousarray(normal), np.ascontiguousarray(friction),
+                     np.ascontiguousarray(wrenches), np.ascontiguousarray(scale, dtype=float),
+                     self._gravity, self._length_scale, sizes, ratios)  # fmt: skip
         problems = []
-        relative = 0.0
-        for rows, unit, size in (
-            (slice(0, 3), "N", force_size),
-            (slice(3, 6), "N m", moment_size),
-        ):
-            ratio = np.abs(residual[rows]).max(axis=0) / size
-            worst = int(np.argmax(ratio))
-            relative = max(relative, float(ratio[worst]))
-            if ratio[worst] > EQUILIBRIUM_RTOL:
+        for row, unit in ((0, "N"), (1, "N m")):
+            worst = int(np.argmax(ratios[row]))
+            ratio, size = ratios[row, worst], sizes[row, worst]
+            if ratio > EQUILIBRIUM_RTOL:
                 problems.append(
                     f"equilibrium residual of load case {worst + 1}: "
-                    f"{ratio[worst] * size[worst]:.3g} {unit}, over {EQUILIBRIUM_RTOL:g} of the "
-                    f"wrenches involved ({size[worst]:.3g} {unit})"
+                    f"{ratio * size:.3g} {unit}, over {EQUILIBRIUM_RTOL:g} of the "
+                    f"wrenches involved ({size:.3g} {unit})"
                 )
+        relative = float(ratios.max(initial=0.0))
         known = answer.get("known_use")
         return relative, problems + self._friction_problems(normal, friction, known)
 
@@ -84,11 +74,13 @@ class Verifier:
         (``known``: the uses already computed for some contacts, see :class:`FrictionUse`)."""
         scale_force = max(float(np.abs(normal).max()), 1e-12)
         noise = FRICTION_SET_RTOL * scale_force
+        use = self._use(friction, normal, noise=noise, known=known)
+        if not _TROUBLED(normal, use, noise):
+            return []
         problems = [
             f"contact {self._names[i]!r} pulls: normal force {normal[i].min():.3g} N"
             for i in np.flatnonzero((normal < -noise).any(axis=1))
         ]
-        use = self._use(friction, normal, noise=noise, known=known)
         pressed = normal > noise
         problems += [
             f"contact {self._names[i]!r} carries friction without normal force"
@@ -107,3 +99,51 @@ class Verifier:
                 f"force, {scale_force:.3g} N)"
             )
         return problems
+
+
+def equilibrium(normal_map, friction_map, normal, friction, wrenches, scale, gravity,
+                length_scale, sizes, ratios):  # fmt: skip  # pragma: no cover - compiled
+    """Each case's largest residual of force and of moment (rows of ``ratios`` ``(2, K)``)
+    over the size of its wrench terms (``sizes``: the largest force and moment of any term,
+    moments at least force × ``length_scale``)."""
+    for k in range(normal.shape[1]):
+        residual = np.zeros(6)
+        magnitude = np.zeros(6)
+        for row in range(6):
+            task = wrenches[row, k] * scale[k]
+            total = task + gravity[row]
+            size = abs(task) + abs(gravity[row])
+            for c in range(normal.shape[0]):
+                term = normal_map[row, c] * normal[c, k]
+                total += term
+                size += abs(term)
+            for d in range(friction.shape[0]):
+                term = friction_map[row, d] * friction[d, k]
+                total += term
+                size += abs(term)
+            residual[row], magnitude[row] = abs(total), size
+        force = max(max(magnitude[0], magnitude[1], magnitude[2]), 1e-12)
+        moment = max(max(magnitude[3], magnitude[4], magnitude[5]), force * length_scale)
+        sizes[0, k], sizes[1, k] = force, moment
+        ratios[0, k] = max(residual[0], residual[1], residual[2]) / force
+        ratios[1, k] = max(residual[3], residual[4], residual[5]) / moment
+
+
+def troubled(normal, use, noise):  # pragma: no cover - compiled
+    """Whether a contact pulls, carries friction without normal force or exceeds its set by
+    more than ``noise`` [N] (see :meth:`Verifier._friction_problems`)."""
+    for c in range(normal.shape[0]):
+        for k in range(normal.shape[1]):
+            force = normal[c, k]
+            if force < -noise:
+                return True
+            if force > noise:
+                if (use[c, k] - 1.0) * force > noise:
+                    return True
+            elif np.isinf(use[c, k]):
+                return True
+    return False
+
+
+_EQUILIBRIUM = compiled_scalar(equilibrium)
+_TROUBLED = compiled_scalar(troubled)
