@@ -276,6 +276,7 @@ def test_verification_measures_the_equilibrium_residual_against_the_wrench_terms
     assert relative == pytest.approx(expected, rel=1e-12)
     assert any(p.startswith("equilibrium residual of load case 1") for p in problems)
 
+
 def test_three_point_contact_set_surface_equals_the_planar_limit_surface_of_the_points():
     xy = np.array([[0.03, 0.0], [-0.02, 0.025], [-0.02, -0.03]])
     forces = np.array([4.0, 8.0, 6.0])

@@ -7,7 +7,9 @@ keeps the problem data as linear maps of the parameter vector with fixed sparsit
 loads and friction bounds of the contact-spring steps of :mod:`fixplan.motion.contact_springs`)
 and the linear cost ``q``. This module applies those maps itself, keeps one Clarabel solver whose
 ``A``, ``b`` and ``q`` are updated in place, and reads the variables and the multipliers of
-equality constraints from the solution vectors. It checks itself against cvxpy's answer when it
+equality constraints from the solution vectors. Linear programs whose loads change only ``b``
+(pyramid models under a force objective) are solved by a warm-started dual simplex (:mod:`fixplan.planner.dual_simplex`) instead, with Clarabel where that
+gives up. It checks itself against cvxpy's answer when it
 is built and refuses (returns ``None``) where its assumptions do not hold (a parametric ``P``,
 cones Clarabel's direct path does not cover, cvxpy internals it does not recognise).
 """
@@ -18,12 +20,17 @@ import cvxpy as cp
 import numpy as np
 import scipy.sparse as sp
 
+from fixplan.planner.dual_simplex import DualSimplex
+
 #: Largest relative difference from cvxpy's own answer accepted when the direct path is built.
 AGREEMENT_RTOL = 1e-6
 
 #: Maps of the parameter vector up to this many entries are applied dense: a sparse product costs
 #: about 10 µs of overhead, as much as a dense one of this size.
 DENSE_MAX_ENTRIES = 20_000
+
+#: Linear programs up to this many constraint-matrix entries go to the dual simplex.
+SIMPLEX_MAX_ENTRIES = 100_000
 
 #: Clarabel's statuses of a problem without a feasible point.
 INFEASIBLE = ("PrimalInfeasible", "AlmostPrimalInfeasible")
@@ -36,9 +43,12 @@ class DirectSolver:
     Build with :meth:`create` after ``problem`` was solved once by cvxpy with Clarabel.
     """
 
-    def __init__(self, problem, solver, program, offsets, equalities):
+    def __init__(self, problem, solver, program, offsets, equalities, simplex=None):
         self._problem = problem
         self._solver = solver
+        self._simplex = simplex  # (DualSimplex, its dense A) or None
+        #: What solved the last problem: ``"dual simplex"`` or ``"CLARABEL"``.
+        self.method = ""
         self._program = program
         self._offsets = offsets
         self._equalities = equalities
@@ -75,7 +85,12 @@ class DirectSolver:
         # The offsets of the variables in Clarabel's x: those of the matrix stuffing, the last
         # reduction that sees variables (canonicalisation may add auxiliary ones before them).
         offsets = [d.var_offsets for d in inverse if hasattr(d, "var_offsets")][-1]
-        direct = cls(problem, solver, program, offsets, equalities)
+        # Linear programs whose loads change b only (force objectives) go to the dual simplex.
+        linear = not dims.soc and program.quadratic.nnz == 0 and program.fixed_a
+        simplex = None
+        if linear and len(b) * len(q) <= SIMPLEX_MAX_ENTRIES:
+            simplex = (DualSimplex(dims.zero), program.matrix(a).toarray())
+        direct = cls(problem, solver, program, offsets, equalities, simplex)
         if not direct._agrees_with_cvxpy():
             return None
         return direct
@@ -83,31 +98,47 @@ class DirectSolver:
     def solve(self, *, accept_inaccurate: bool = False) -> dict | None:
         """Variable values by id after a solve with the parameters' current values.
 
-        ``None`` when Clarabel does not report the problem solved (or almost solved, with
-        ``accept_inaccurate``); :attr:`status` says why (use cvxpy then: it turns infeasibility
-        into certificates).
+        A linear program with a fixed ``A`` goes to the warm-started dual simplex first, and to
+        Clarabel where the simplex gives up (:mod:`fixplan.planner.dual_simplex`). ``None`` when Clarabel does not
+        report the problem solved (or almost solved, with ``accept_inaccurate``); :attr:`status`
+        says why (use cvxpy then: it turns infeasibility into certificates).
         """
         vector = self._program.parameter_vector()
         q, constant = self._program.cost(vector)
         a, b = self._program.constraints(vector)
-        update = {"q": q, "b": b}
-        if not self._program.fixed_a:
-            update["A"] = a  # the same pattern, so only the values change
-        self._solver.update(**update)
-        solution = self._solver.solve()
-        self.status = str(solution.status)
-        if self.status != "Solved" and not (accept_inaccurate and self.status == "AlmostSolved"):
-            return None
-        value = float(solution.obj_val) + constant  # of the minimisation cvxpy compiled
+        found = self._simplex_solve(q, b)
+        if found is not None:
+            x, self._dual = found
+            value = float(q @ x)
+            self.status, self.method = "Solved", "dual simplex"
+        else:
+            update = {"q": q, "b": b}
+            if not self._program.fixed_a:
+                update["A"] = a  # the same pattern, so only the values change
+            self._solver.update(**update)
+            solution = self._solver.solve()
+            self.status, self.method = str(solution.status), "CLARABEL"
+            solved = self.status == "Solved"
+            if not (solved or (accept_inaccurate and self.status == "AlmostSolved")):
+                return None
+            x, self._dual = np.asarray(solution.x), np.asarray(solution.z)
+            value = float(solution.obj_val)
+        value += constant  # of the minimisation cvxpy compiled
         self.objective_value = -value if isinstance(self._problem.objective, cp.Maximize) else value
-        self._dual = np.asarray(solution.z)
-        x = np.asarray(solution.x)
         values = {}
         for variable in self._problem.variables():
             start = self._offsets[variable.id]
             chunk = x[start : start + variable.size]
             values[variable.id] = chunk.reshape(variable.shape, order="F")
         return values
+
+    def _simplex_solve(self, q, b) -> tuple[np.ndarray, np.ndarray] | None:
+        """``(x, z)`` from the dual simplex of a linear program whose ``A`` is fixed, or
+        ``None`` (not such a program, or the simplex gave up: Clarabel then solves it)."""
+        if self._simplex is None:
+            return None
+        simplex, matrix = self._simplex
+        return simplex.solve(matrix, q, b)
 
     def dual(self, constraint: cp.Constraint) -> np.ndarray | None:
         """The multipliers of equality ``constraint`` after :meth:`solve`, as cvxpy gives them

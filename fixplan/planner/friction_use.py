@@ -53,6 +53,7 @@ class FrictionUse:
         self._kinds = np.array(kinds, dtype=np.intp)
         self._owners = np.array(owners, dtype=np.intp)
         self._first = np.array(first, dtype=np.intp)
+        self._asked_indices = np.flatnonzero(self._asked).tolist()
 
     def __call__(
         self,
@@ -75,7 +76,7 @@ class FrictionUse:
         use = np.empty(normal.shape)
         _USES(friction, normal, float(noise), self._starts, self._stops, self._asked,
               self._rows, self._kinds, self._owners, self._first, use)  # fmt: skip
-        for i in np.flatnonzero(self._asked):
+        for i in self._asked_indices:
             ask = np.isnan(use[i])  # pressed and carrying a load
             if known is not None:
                 found = ask & np.isfinite(known[i])

@@ -88,6 +88,13 @@ class Planner:
         spread = np.linalg.norm(positions - problem.body.center_of_mass, axis=1)
         self.length_scale = float(max(spread.max(), 1e-3))
         self._passive = np.array([c.role in PASSIVE_ROLES for c in problem.contacts])
+        # Where each row of the stacked friction loads goes in the contact wrenches of a plan.
+        self._friction_owner = np.concatenate(
+            [np.full(part.stop - part.start, i) for i, part in enumerate(self.layout.slices)]
+        ).astype(np.intp)
+        self._friction_component = np.concatenate(
+            [np.arange(1, 1 + part.stop - part.start) for part in self.layout.slices]
+        ).astype(np.intp)
         self._staying = StayingInContact(self.layout.normal_map, self._passive, self.length_scale)
         self._verify = Verifier(problem, self.layout, self.friction_use, self.length_scale)
         passive_map = self.layout.normal_map[:, self._passive]
@@ -155,7 +162,7 @@ class Planner:
             notes += self._squeeze_notes(squeezed)
             return self._plan(status, None, result["solver"], start, notes, fields)
         residual, problems = self._verify(result, wrenches)
-        if problems and result["solver"].startswith("CLARABEL"):
+        if problems and result["solver"].startswith(("CLARABEL", "dual simplex")):
             retry = self._squeeze_free(
                 objective, wrenches, given, squeezed, accurate=True, disabled=off
             )
@@ -351,9 +358,7 @@ class Planner:
         contacts, cases = normal.shape
         out = np.zeros((contacts, cases, 4))
         out[:, :, 0] = normal
-        for i, part in enumerate(self.layout.slices):
-            values = friction[part].T
-            out[i, :, 1 : 1 + values.shape[1]] = values
+        out[self._friction_owner, :, self._friction_component] = friction
         return out
 
 

@@ -298,8 +298,9 @@ class Load:
     @property
     def wrench(self) -> np.ndarray:
         """``(force, moment about the world origin)`` [N, N m]."""
-        (x, y, z), (fx, fy, fz), (tx, ty, tz) = self.point, self.force, self.torque
-        # The cross product written out: np.cross costs more than the rest of the wrench.
+        point, force, torque = self.point.tolist(), self.force.tolist(), self.torque.tolist()
+        (x, y, z), (fx, fy, fz), (tx, ty, tz) = point, force, torque
+        # The cross product written out in floats: np.cross costs more than the rest.
         return np.array(
             [fx, fy, fz, y * fz - z * fy + tx, z * fx - x * fz + ty, x * fy - y * fx + tz]
         )

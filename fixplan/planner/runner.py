@@ -232,7 +232,8 @@ class Runner:
         if not self._direct_into(objective, stacked):
             return None
         dual = np.asarray(stacked.balance.dual_value, dtype=float)
-        return {"status": "optimal", "solver": "CLARABEL (direct)", "warnings": [],
+        solver = f"{self._direct[objective].method} (direct)"
+        return {"status": "optimal", "solver": solver, "warnings": [],
                 **_values(stacked), "dual": dual}  # fmt: skip
 
     def _prepare_direct(self, objective: str, stacked: Stacked) -> None:

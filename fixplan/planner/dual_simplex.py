@@ -1,0 +1,262 @@
+r"""A warm-started simplex method for the small linear programs of pyramid models.
+
+With pyramid friction models (and a linear objective) the planner's problems are linear
+programs in Clarabel's form
+
+.. math:: \min q^T x \quad\text{s.t.}\quad A_E x = b_E,\; A_I x \le b_I ,
+
+of a few dozen variables, re-solved with new right-hand sides ``b`` (the loads and given forces
+of a force objective; ``A`` and ``q`` stay). An interior-point method starts from scratch every
+time (about 10 iterations); the dual simplex starts from the last optimal *basis*: ``n`` active
+rows ``W`` (all equalities among them) with an invertible matrix ``B = A_W``, the vertex
+``x = B^{-1} b_W`` and the multipliers ``z_W = -B^{-T} q``, optimal when the vertex satisfies
+every row and the multipliers of the inequalities are nonnegative. Those multipliers do not
+depend on ``b``, so the last basis stays dual feasible; each pivot brings the most violated row
+in and takes out the row whose multiplier reaches 0 first, until the vertex is feasible: a few
+pivots of ``O(n^2 + m n)`` each, compiled, without BLAS (whose threads cost more than these
+small products when the machine is busy).
+
+The first solve starts from an artificial basis that is dual feasible by construction: the equality rows and, for every variable outside a set that
+makes the equality rows invertible, a bound ``±x_i <= BOUND`` on the side that makes its
+multiplier nonnegative. A solve that ends with an artificial bound in the basis (an unbounded
+program or one beyond ``BOUND``), finds the program infeasible or unbounded, or exceeds
+``MAX_PIVOTS_PER_ROW`` pivots per row returns ``None``: the caller then asks Clarabel, which
+also gives the infeasibility certificates.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg
+
+from fixplan.surface.point_kernel import compiled_scalar
+
+#: The artificial bounds of the first basis: far beyond any force [N] or multiple a plan has.
+BOUND = 1e9
+#: A row is violated when it exceeds its right-hand side by more than this fraction of the
+#: sizes of its terms (``|b_i| + |a_i| |x|``).
+FEASIBILITY_RTOL = 1e-12
+#: A multiplier may be this fraction of ``max |q|`` below 0 and still count as nonnegative.
+OPTIMALITY_RTOL = 1e-10
+#: Pivots allowed per row of the program before the solve gives up (cycling).
+MAX_PIVOTS_PER_ROW = 4
+#: The basis inverse is computed afresh after this many rank-one updates.
+REFACTOR_EVERY = 32
+
+
+class DualSimplex:
+    """Warm-started simplex for ``min q·x`` s.t. ``A x = b`` on the first ``equalities`` rows
+    and ``A x <= b`` on the rest (``A`` dense: small programs only).
+
+    The optimal basis of each objective ``q`` is kept as the start of its next solve; ``A``
+    must not change between solves.
+    """
+
+    def __init__(self, equalities: int):
+        self._equalities = int(equalities)
+        self._bases: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+        #: Pivots of the last solve.
+        self.pivots = 0
+
+    def solve(
+        self, a: np.ndarray, q: np.ndarray, b: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray] | None:
+        """The optimal ``x`` ``(n,)`` and multipliers ``z`` ``(m,)`` (``q + A^T z = 0``,
+        ``z >= 0`` on the inequalities, 0 off the active rows), or ``None`` (see the module)."""
+        key = q.tobytes()
+        found = None
+        if key in self._bases:
+            rows, inverse = self._bases[key]
+            self.pivots = 0
+            found = self._pivot(a, q, b, rows.copy(), inverse.copy())
+        if found is None:
+            found = self._cold(a, q, b)
+        if found is None:
+            return None
+        x, z, rows, inverse = found
+        if len(self._bases) >= 8 and key not in self._bases:
+            self._bases.clear()
+        self._bases[key] = (rows, inverse)
+        return x, z
+
+    def _cold(self, a, q, b):
+        """From the artificial basis: ``a`` with the rows ``x_i <= BOUND`` (``m + i``) and
+        ``-x_i <= BOUND`` (``m + n + i``) appended."""
+        m, n = a.shape
+        e = self._equalities
+        equal = a[:e]
+        if e:
+            _, _, order = scipy.linalg.qr(equal, pivoting=True, mode="economic")
+            pivots = np.sort(order[:e])
+            square = equal[:, pivots]
+            if np.linalg.matrix_rank(square) < e:
+                return None  # dependent equalities
+            reduced = q + equal.T @ np.linalg.solve(square.T, -q[pivots])
+        else:
+            pivots, reduced = np.zeros(0, dtype=np.intp), q
+        free = np.setdiff1d(np.arange(n), pivots)
+        rows = np.concatenate(
+            [np.arange(e), np.where(reduced[free] >= 0.0, m + n + free, m + free)]
+        )
+        bounded = np.vstack([a, np.eye(n), -np.eye(n)])
+        try:
+            inverse = np.linalg.inv(bounded[rows])
+        except np.linalg.LinAlgError:
+            return None
+        rows = rows.astype(np.intp)
+        self.pivots = 0
+        bounds = np.full(2 * n, BOUND)
+        found = self._pivot(bounded, q, np.concatenate([b, bounds]), rows, inverse)
+        if found is None or np.any(rows >= m):  # an artificial bound still holds the vertex
+            return None
+        x, z, rows, inverse = found
+        return x, z[:m], rows, inverse
+
+    def _pivot(self, a, q, b, rows, inverse):
+        """Dual simplex pivots from the basis ``rows`` (updated in place, with ``inverse``):
+        ``(x, z, rows, inverse)`` at the optimum, or ``None`` if they failed."""
+        m, n = a.shape
+        x, z = np.empty(n), np.zeros(m)
+        limit = MAX_PIVOTS_PER_ROW * (m + n)
+        pivots = _PIVOTS(a, b, q, self._equalities, rows, inverse, x, z, limit,
+                            FEASIBILITY_RTOL, OPTIMALITY_RTOL, REFACTOR_EVERY)  # fmt: skip
+        if pivots < 0:
+            return None
+        self.pivots += pivots
+        return x, z, rows, inverse
+
+
+def dual_pivots(a, b, q, equalities, rows, inverse, x, z, limit, feasibility, optimality,
+                refactor):  # fmt: skip  # pragma: no cover - compiled
+    """Dual simplex pivots from the dual feasible basis ``rows`` (with ``inverse``, both
+    updated in place) until its vertex ``x`` is feasible; ``z`` gets the multipliers. Returns
+    the number of pivots, or -1 (infeasible program, too many pivots, multipliers < 0, a
+    singular basis)."""
+    m, n = a.shape
+    size = np.zeros(m)
+    norm = np.zeros(m)
+    for i in range(m):
+        for j in range(n):
+            size[i] += abs(a[i, j])
+            norm[i] += a[i, j] * a[i, j]
+    norm = np.sqrt(norm)
+    q_size = 0.0
+    for j in range(n):
+        q_size = max(q_size, abs(q[j]))
+    active = np.zeros(m, dtype=np.bool_)
+    for k in range(n):
+        active[rows[k]] = True
+    z_rows, d = np.empty(n), np.empty(n)
+    pivots, since = 0, 0
+    while True:
+        x_size = 0.0
+        for j in range(n):
+            total = 0.0
+            for k in range(n):
+                total += inverse[j, k] * b[rows[k]]
+            x[j] = total
+            x_size = max(x_size, abs(total))
+        entering, worst = -1, 0.0
+        for i in range(equalities, m):
+            if active[i]:
+                continue
+            excess = -b[i]
+            for j in range(n):
+                excess += a[i, j] * x[j]
+            if excess > feasibility * (abs(b[i]) + size[i] * x_size) and excess > worst * norm[i]:
+                entering, worst = i, excess / norm[i]
+        for k in range(n):  # z_W = -B^-T q
+            total = 0.0
+            for j in range(n):
+                total -= inverse[j, k] * q[j]
+            z_rows[k] = total
+        if entering < 0:
+            if since > 0:  # confirm on a fresh inverse
+                if not invert(a, rows, inverse):
+                    return -1
+                since = 0
+                continue
+            for k in range(n):
+                if rows[k] >= equalities and z_rows[k] < -optimality * q_size:
+                    return -1
+            z[:] = 0.0
+            for k in range(n):
+                z[rows[k]] = z_rows[k]
+            return pivots
+        if pivots >= limit:
+            return -1
+        # Multipliers along the entering row: z_W(t) = z_W - t d, with d = B^-T a_j.
+        d_size = 0.0
+        for k in range(n):
+            total = 0.0
+            for j in range(n):
+                total += inverse[j, k] * a[entering, j]
+            d[k] = total
+            d_size = max(d_size, abs(total))
+        leaving, ratio, best = -1, np.inf, 0.0
+        for k in range(n):
+            if rows[k] < equalities or d[k] <= 1e-9 * d_size:
+                continue
+            t = max(z_rows[k], 0.0) / d[k]
+            if t < ratio * (1.0 - 1e-12) or (t <= ratio * (1.0 + 1e-12) and d[k] > best):
+                leaving, ratio, best = k, t, d[k]
+        if leaving < 0:
+            return -1  # no row can leave: the program is infeasible
+        # Row k of B becomes a_j: B^-1 - B^-1 e_k (a_j^T B^-1 - e_k^T) / d_k.
+        pivot = d[leaving]
+        d[leaving] -= 1.0
+        for j in range(n):
+            factor = inverse[j, leaving] / pivot
+            if factor != 0.0:
+                for k in range(n):
+                    inverse[j, k] -= factor * d[k]
+        active[rows[leaving]] = False
+        active[entering] = True
+        rows[leaving] = entering
+        pivots += 1
+        since += 1
+        if since >= refactor:
+            if not invert(a, rows, inverse):
+                return -1
+            since = 0
+
+
+def invert(a, rows, inverse):  # pragma: no cover - compiled
+    """``inverse`` = ``a[rows]^-1`` by Gauss-Jordan elimination with partial pivoting (no
+    LAPACK: see the module); ``False`` if the basis is singular."""
+    n = rows.shape[0]
+    work = np.empty((n, 2 * n))
+    for i in range(n):
+        for j in range(n):
+            work[i, j] = a[rows[i], j]
+            work[i, n + j] = 1.0 if i == j else 0.0
+    scale = 0.0
+    for i in range(n):
+        for j in range(n):
+            scale = max(scale, abs(work[i, j]))
+    for col in range(n):
+        best, row = 0.0, -1
+        for i in range(col, n):
+            if abs(work[i, col]) > best:
+                best, row = abs(work[i, col]), i
+        if best <= 1e-14 * scale:
+            return False
+        if row != col:
+            for j in range(2 * n):
+                work[row, j], work[col, j] = work[col, j], work[row, j]
+        pivot = work[col, col]
+        for j in range(2 * n):
+            work[col, j] /= pivot
+        for i in range(n):
+            factor = work[i, col]
+            if i != col and factor != 0.0:
+                for j in range(2 * n):
+                    work[i, j] -= factor * work[col, j]
+    for i in range(n):
+        for j in range(n):
+            inverse[i, j] = work[i, n + j]
+    return True
+
+
+invert = compiled_scalar(invert)
+_PIVOTS = compiled_scalar(dual_pivots)

@@ -1,0 +1,115 @@
+"""The warm-started dual simplex against HiGHS (scipy's linprog), and in the planner."""
+
+import numpy as np
+import pytest
+from scipy.optimize import linprog
+
+from fixplan.planner.dual_simplex import DualSimplex
+from fixplan.planner.planner import Planner
+from fixplan.planner.problem import Body, Contact, Load, Problem
+
+#: Optimal values agree with HiGHS to this relative tolerance; optimality conditions hold to it.
+RTOL = 1e-9
+
+
+def _random_program(rng, n, equalities, inequalities):
+    """A program ``(A, q)`` of random rows with a box, and ``b(shift)``: the right-hand side
+    of a feasible point moved by ``shift`` with random slacks (feasible and bounded)."""
+    rows = rng.normal(size=(equalities + inequalities, n))
+    a = np.vstack([rows, np.eye(n), -np.eye(n)])
+    point = rng.normal(size=n)
+
+    def right_hand_side(shift):
+        moved = point + shift * rng.normal(size=n)
+        b = rows @ moved
+        b[equalities:] += rng.uniform(0.0, 1.0, size=inequalities)
+        return np.r_[b, np.full(2 * n, 10.0 + np.abs(point).max() + shift * 10.0)]
+
+    return a, rng.normal(size=n), right_hand_side
+
+
+def _highs(a, b, q, equalities):
+    return linprog(
+        q, A_ub=a[equalities:], b_ub=b[equalities:], A_eq=a[:equalities] if equalities else None,
+        b_eq=b[:equalities] if equalities else None, bounds=(None, None), method="highs",
+    )  # fmt: skip
+
+
+def _assert_optimal(a, b, q, equalities, x, z, expected):
+    scale = max(1.0, abs(expected))
+    assert q @ x == pytest.approx(expected, abs=RTOL * scale)
+    residual = a @ x - b
+    size = np.abs(b) + np.abs(a).sum(axis=1) * np.abs(x).max()
+    assert np.all(np.abs(residual[:equalities]) <= RTOL * size[:equalities])
+    assert np.all(residual[equalities:] <= RTOL * size[equalities:])  # feasible
+    np.testing.assert_allclose(q + a.T @ z, 0.0, atol=RTOL * np.abs(q).max())  # stationary
+    assert np.all(z[equalities:] >= -RTOL * np.abs(q).max())  # dual feasible
+    assert np.all(np.abs(z * residual)[equalities:] <= RTOL * scale)  # complementary
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_warm_re_solves_with_new_right_hand_sides_match_highs(seed):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(3, 30))
+    equalities = int(rng.integers(0, min(n, 7)))
+    a, q, right_hand_side = _random_program(rng, n, equalities, int(rng.integers(n, 4 * n)))
+    simplex = DualSimplex(equalities)
+    pivots = []
+    for step in range(12):
+        b = right_hand_side(0.1 * step)
+        reference = _highs(a, b, q, equalities)
+        assert reference.status == 0
+        x, z = simplex.solve(a, q, b)
+        _assert_optimal(a, b, q, equalities, x, z, reference.fun)
+        pivots.append(simplex.pivots)
+    assert max(pivots[1:]) > 0  # the warm starts pivoted
+
+
+def test_a_degenerate_vertex_of_many_rows_is_found():
+    # min -x - y under 40 lines through (1, 1) (a pyramid's facets meeting at one vertex), and
+    # the same rows duplicated: massively degenerate.
+    angles = np.linspace(0.05, np.pi / 2 - 0.05, 40)
+    rows = np.column_stack([np.cos(angles), np.sin(angles)])
+    a = np.vstack([rows, rows])
+    b = a @ np.ones(2)
+    x, z = DualSimplex(0).solve(a, np.array([-1.0, -1.0]), b)
+    np.testing.assert_allclose(x, [1.0, 1.0], rtol=1e-12)
+    np.testing.assert_allclose(a.T @ z, [1.0, 1.0], rtol=1e-12)
+
+
+def test_infeasible_and_unbounded_programs_give_none():
+    infeasible = np.array([[1.0], [-1.0]])  # x <= -1 and x >= 1
+    assert DualSimplex(0).solve(infeasible, np.array([1.0]), np.array([-1.0, -1.0])) is None
+    below = np.array([[1.0]])  # min x with x <= 1
+    assert DualSimplex(0).solve(below, np.array([1.0]), np.array([1.0])) is None
+
+
+def _pyramid_grasp(load):
+    contacts = [
+        Contact(name=name, role="finger", position=[0.0, side * 0.03, 0.0],
+                normal=[0.0, -side, 0.0], mu=0.4, model="point-pyramid", facets=8)
+        for name, side in (("left", -1), ("right", 1))
+    ]  # fmt: skip
+    contacts.append(
+        Contact(name="palm", role="support", position=[0.0, 0.0, -0.02], normal=[0.0, 0.0, 1.0],
+                mu=0.3, model="point-pyramid", facets=6)
+    )  # fmt: skip
+    body = Body(mass=0.3, center_of_mass=[0.0, 0.0, 0.0])
+    return Problem(body=body, contacts=tuple(contacts), loads=(load,),
+                   objective="min-total-normal-force")  # fmt: skip
+
+
+def test_planner_re_solves_through_the_simplex_equal_fresh_solves():
+    def load(angle):
+        return Load(name="push", force=[4.0 * np.cos(angle), 2.0, -5.0 + np.sin(angle)],
+                    point=[0.01, 0.0, 0.01])  # fmt: skip
+
+    planner = Planner(_pyramid_grasp(load(0.0)))
+    for angle in np.linspace(0.0, 2.0, 4):  # cvxpy twice, then the direct path
+        planner.solve([load(angle)])
+    for angle in np.linspace(0.0, 6.0, 15):
+        plan = planner.solve([load(angle)], analyse=False)
+        fresh = Planner(_pyramid_grasp(load(angle))).solve(analyse=False)
+        assert plan.solver == "dual simplex (direct)"
+        assert plan.status == fresh.status == "optimal"
+        assert plan.objective_value == pytest.approx(fresh.objective_value, rel=1e-7)
