@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fixplan import validation
 from fixplan.errors import InvalidArgumentError, MissingExtraError
 from fixplan.planner.problem import Contact, Problem
 from fixplan.surface import pressure
@@ -142,27 +143,19 @@ class DrakeScene:
     """
 
     def __init__(self, problem: Problem, design_forces: np.ndarray):
-        from pydrake.geometry import (
-            AddCompliantHydroelasticProperties,
-            AddContactMaterial,
-            AddRigidHydroelasticProperties,
-            Box,
-            CollisionFilterDeclaration,
-            GeometrySet,
-            ProximityProperties,
-            Sphere,
-        )
-        from pydrake.math import RigidTransform, RotationMatrix
-        from pydrake.multibody.plant import AddMultibodyPlant, CoulombFriction, MultibodyPlantConfig
-        from pydrake.multibody.tree import (
-            FixedOffsetFrame,
-            PrismaticJoint,
-            RotationalInertia,
-            SpatialInertia,
-        )
+        from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
+        from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig
+        from pydrake.multibody.tree import RotationalInertia, SpatialInertia
         from pydrake.systems.analysis import Simulator
         from pydrake.systems.framework import DiagramBuilder
 
+        design_forces = validation.finite_array(
+            "design_forces", design_forces, shape=(len(problem.contacts),)
+        )
+        if np.any(design_forces <= 0.0):
+            raise InvalidArgumentError(
+                f"design_forces must be positive normal forces [N], got {design_forces.tolist()}"
+            )
         builder = DiagramBuilder()
         config = MultibodyPlantConfig(
             time_step=TIME_STEP,
@@ -193,44 +186,11 @@ class DrakeScene:
         ]
         pads, spheres, self.joints, self.tip_bodies = [], [], [], []
         for contact, tip in zip(problem.contacts, self.tips, strict=True):
-            friction = CoulombFriction(contact.mu, contact.mu)
-            half = PAD_OVER_PATCH * tip.patch_radius
-            pad = ProximityProperties()
-            AddRigidHydroelasticProperties(2.0 * half, pad)
-            AddContactMaterial(friction=friction, properties=pad)
-            facing = RotationMatrix.MakeFromOneVector(contact.normal, 2)
-            middle = contact.position + 0.5 * half * contact.normal - self.center
-            pads.append(
-                plant.RegisterCollisionGeometry(part, RigidTransform(facing, middle),
-                                                Box(2.0 * half, 2.0 * half, half),
-                                                f"pad-{contact.name}", pad)
-            )  # fmt: skip
-            soft = ProximityProperties()
-            AddCompliantHydroelasticProperties(RESOLUTION * tip.radius, tip.modulus, soft)
-            AddContactMaterial(dissipation=DISSIPATION, friction=friction, properties=soft)
-            place = contact.position - (tip.radius - tip.depth) * contact.normal
-            if contact.is_active:
-                holder = plant.AddRigidBody(
-                    f"tip-{contact.name}", SpatialInertia.SolidSphereWithMass(TIP_MASS, tip.radius)
-                )
-                rail = plant.AddFrame(
-                    FixedOffsetFrame(
-                        f"rail-{contact.name}", plant.world_frame(), RigidTransform(place)
-                    )
-                )
-                self.joints.append(
-                    plant.AddJoint(PrismaticJoint(f"push-{contact.name}", rail,
-                                                  holder.body_frame(), contact.normal))
-                )  # fmt: skip
-                pose = RigidTransform()
-            else:
-                holder, pose = plant.world_body(), RigidTransform(place)
-                self.joints.append(None)
+            pad, sphere, joint, holder = _add_contact(plant, part, contact, tip, self.center)
+            pads.append(pad)
+            spheres.append(sphere)
+            self.joints.append(joint)
             self.tip_bodies.append(holder)
-            spheres.append(
-                plant.RegisterCollisionGeometry(holder, pose, Sphere(tip.radius),
-                                                f"tip-{contact.name}", soft)
-            )  # fmt: skip
         plant.Finalize()
         declaration = CollisionFilterDeclaration().ExcludeWithin(GeometrySet(spheres))
         for index, sphere in enumerate(spheres):
@@ -332,10 +292,10 @@ class DrakeScene:
         omega = velocity.rotational()
         return np.r_[velocity.translational() - np.cross(omega, origin), omega]
 
-    def patches(self) -> list[tuple[np.ndarray, np.ndarray] | None]:
+    def patches(self) -> list[tuple[np.ndarray, np.ndarray, np.ndarray] | None]:
         """Per contact, the engine's contact surface in patch coordinates: polygon centroids
-        ``(n, 2)`` [m] about the contact point along its ``t1, t2`` and the pressure there [Pa],
-        with the polygons' areas as a third array; ``None`` where the contact is open."""
+        ``(n, 2)`` [m] about the contact point along its ``t1, t2``, the pressure there [Pa] and
+        the polygons' areas [m²]; ``None`` where the contact is open."""
         from fixplan.sim.drake_check import surface_polygons
 
         context = self.plant_context
@@ -353,6 +313,55 @@ class DrakeScene:
             xy = (in_part - contact.position) @ contact.frame[:2].T
             found[contact_index] = (xy, pressures, areas)
         return found
+
+
+def _add_contact(plant, part, contact: Contact, tip: Fingertip, center: np.ndarray) -> tuple:
+    """Register ``contact``'s rigid pad on ``part`` and its compliant sphere, fixed in the
+    world or on a prismatic joint along the normal; returns the pad's and the sphere's geometry
+    ids, the joint (``None`` when fixed) and the body holding the sphere."""
+    from pydrake.geometry import (
+        AddCompliantHydroelasticProperties,
+        AddContactMaterial,
+        AddRigidHydroelasticProperties,
+        Box,
+        ProximityProperties,
+        Sphere,
+    )
+    from pydrake.math import RigidTransform, RotationMatrix
+    from pydrake.multibody.plant import CoulombFriction
+    from pydrake.multibody.tree import FixedOffsetFrame, PrismaticJoint, SpatialInertia
+
+    friction = CoulombFriction(contact.mu, contact.mu)
+    half = PAD_OVER_PATCH * tip.patch_radius
+    rigid = ProximityProperties()
+    AddRigidHydroelasticProperties(2.0 * half, rigid)
+    AddContactMaterial(friction=friction, properties=rigid)
+    facing = RotationMatrix.MakeFromOneVector(contact.normal, 2)
+    middle = contact.position + 0.5 * half * contact.normal - center
+    pad = plant.RegisterCollisionGeometry(part, RigidTransform(facing, middle),
+                                          Box(2.0 * half, 2.0 * half, half),
+                                          f"pad-{contact.name}", rigid)  # fmt: skip
+    soft = ProximityProperties()
+    AddCompliantHydroelasticProperties(RESOLUTION * tip.radius, tip.modulus, soft)
+    AddContactMaterial(dissipation=DISSIPATION, friction=friction, properties=soft)
+    place = contact.position - (tip.radius - tip.depth) * contact.normal
+    joint = None
+    if contact.is_active:
+        holder = plant.AddRigidBody(
+            f"tip-{contact.name}", SpatialInertia.SolidSphereWithMass(TIP_MASS, tip.radius)
+        )
+        rail = plant.AddFrame(
+            FixedOffsetFrame(f"rail-{contact.name}", plant.world_frame(), RigidTransform(place))
+        )
+        joint = plant.AddJoint(
+            PrismaticJoint(f"push-{contact.name}", rail, holder.body_frame(), contact.normal)
+        )
+        pose = RigidTransform()
+    else:
+        holder, pose = plant.world_body(), RigidTransform(place)
+    sphere = plant.RegisterCollisionGeometry(holder, pose, Sphere(tip.radius),
+                                             f"tip-{contact.name}", soft)  # fmt: skip
+    return pad, sphere, joint, holder
 
 
 def _rotation_vector(rotation: np.ndarray) -> np.ndarray:
