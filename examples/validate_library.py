@@ -69,7 +69,8 @@ def _drake_columns(case) -> tuple[str, ...]:
 
     deviation = spread([f.pressure_deviation for f in case.fields], "{:.0%}")
     torsion = spread([f.torsion_ratio for f in case.fields], "{:.3f}")
-    return (f"{case.exact_safety_factor:.4g}", ratio, deviation, torsion)
+    exact = "none held" if case.exact_safety_factor is None else f"{case.exact_safety_factor:.4g}"
+    return (exact, ratio, deviation, torsion)
 
 
 def main() -> int:

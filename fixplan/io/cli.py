@@ -697,7 +697,8 @@ def _case_document(case) -> dict:
         document["fields"] = [
             {"contact": item.contact, "normal_force_N": item.normal_force,
              "polygons": item.polygons, "peak_pressure_Pa": item.peak_pressure,
-             "pressure_deviation": item.pressure_deviation, "torsion_ratio": item.torsion_ratio}
+             "pressure_deviation": item.pressure_deviation, "torsion_ratio": item.torsion_ratio,
+             "onset_use": item.onset_use}
             for item in case.fields
         ]  # fmt: skip
     return document
@@ -715,8 +716,8 @@ def _validation_lines(problem_file, cases, margin: float, engine: str) -> list[s
         "against the part; area contacts: plus their turn times their radius) while the task "
         "load ramps to 1x",
         f"onset      a contact slips faster than {thresholds['onset_speed_m_per_s'] * 1e3:g} mm/s"
-        + ("; s exact: fixplan's exact limit surface of the engine's pressure fields" if drake
-           else ""),
+        + ("; s exact: fixplan's exact limit surface of the engine's pressure fields (none: "
+           "they do not hold the part at any multiple)" if drake else ""),
         f"{'load case':28s} {'plan':>8s} {up:>8s} {down:>8s} {'onset/s':>8s} {'motion':>8s}"
         + (f" {'s exact':>8s} {'onset/s exact':>13s}" if drake else ""),
     ]  # fmt: skip
@@ -728,7 +729,8 @@ def _validation_lines(problem_file, cases, margin: float, engine: str) -> list[s
         exact = ""
         if drake:
             exact_ratio = "-" if case.exact_onset_ratio is None else f"{case.exact_onset_ratio:.3f}"
-            exact = f" {case.exact_safety_factor:8.4g} {exact_ratio:>13s}"
+            held = "none" if case.exact_safety_factor is None else f"{case.exact_safety_factor:.4g}"
+            exact = f" {held:>8s} {exact_ratio:>13s}"
         lines.append(
             f"{case.load:28s} {'held' if case.planned_held else 'slips':>8s} "
             f"{verdict(case.above):>8s} {verdict(case.below):>8s} {ratio:>8s} {angle:>8s}"
@@ -736,10 +738,13 @@ def _validation_lines(problem_file, cases, margin: float, engine: str) -> list[s
         )
         for item in case.fields if drake else ():
             deviation = "-" if item.pressure_deviation is None else f"{item.pressure_deviation:.1%}"
+            use = (
+                "" if item.onset_use is None else f", at onset {item.onset_use:.3f} of its exact LS"
+            )
             lines.append(
                 f"  field {item.contact}: {item.normal_force:.4g} N on {item.polygons} polygons, "
                 f"pressure off the assumed profile by {deviation} of its peak "
-                f"{item.peak_pressure / 1e6:.3g} MPa, torsion {item.torsion_ratio:.3f}x assumed"
+                f"{item.peak_pressure / 1e6:.3g} MPa, torsion {item.torsion_ratio:.3f}x assumed{use}"
             )
     return lines
 

@@ -131,13 +131,16 @@ def _field_blocks(cases) -> list:
     rows, fields = [], []
     for case in cases:
         ratio = "-" if case.exact_onset_ratio is None else f"{case.exact_onset_ratio:.4f}"
-        rows.append((case.load, f"{case.safety_factor:.4g}", f"{case.exact_safety_factor:.4g}",
-                     ratio))  # fmt: skip
+        exact = (
+            "none held" if case.exact_safety_factor is None else f"{case.exact_safety_factor:.4g}"
+        )
+        rows.append((case.load, f"{case.safety_factor:.4g}", exact, ratio))
         for item in case.fields:
             deviation = "-" if item.pressure_deviation is None else f"{item.pressure_deviation:.1%}"
             fields.append((case.load, item.contact, f"{item.normal_force:.4g}",
                            str(item.polygons), f"{item.peak_pressure / 1e6:.3g}", deviation,
-                           f"{item.torsion_ratio:.3f}"))  # fmt: skip
+                           f"{item.torsion_ratio:.3f}",
+                           "-" if item.onset_use is None else f"{item.onset_use:.3f}"))  # fmt: skip
     return [
         Heading(2, inline("Drake's pressure fields and fixplan's exact limit surface of them")),
         Paragraph(
@@ -147,8 +150,10 @@ def _field_blocks(cases) -> list:
                 "onset over it. Per area contact, that field (read when the task load reaches "
                 "1× at the planned forces, or at slip onset if sooner) against the profile the "
                 "plan assumed at the same normal force: the largest pressure difference at the "
-                "engine's polygons over its peak pressure, and the largest friction moment per "
-                "unit mu N over the assumed patch's."
+                "engine's polygons over its peak pressure, the largest friction moment per "
+                "unit mu N over the assumed patch's, and the shear and torsion the engine "
+                "applied there at slip onset as a fraction of the exact limit surface of its "
+                "field then."
             )
         ),
         Table(

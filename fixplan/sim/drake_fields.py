@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fixplan.planner.problem import Contact
+from fixplan.sim.drake_scene import EnginePatch
 from fixplan.surface import pressure
 from fixplan.surface.limit_surface import LimitSurface
 
@@ -40,6 +41,11 @@ class ContactField:
     torsion_ratio : float
         The engine field's largest friction moment about the contact point over the assumed
         patch's, both per unit ``mu N`` [-].
+    onset_use : float or None
+        The shear and torsion ``(ft1, ft2, mn)`` the engine applied at this contact when the part
+        started to slide, as a fraction of the exact limit surface of the contact's engine field
+        at that moment and normal force (1: on the limit) [-]; ``None`` if the part did not slide
+        or the contact is frictionless.
     """
 
     contact: str
@@ -49,6 +55,7 @@ class ContactField:
     areas: np.ndarray
     pressure_deviation: float | None
     torsion_ratio: float
+    onset_use: float | None
 
     @property
     def polygons(self) -> int:
@@ -62,30 +69,50 @@ class ContactField:
 
 
 def contact_field(
-    contact: Contact, xy: np.ndarray, pressures: np.ndarray, areas: np.ndarray
+    contact: Contact, patch: EnginePatch, at_onset: EnginePatch | None = None
 ) -> ContactField:
-    """Compare the engine's polygons of ``contact`` (centroids ``xy`` [m] in its patch
-    coordinates, ``pressures`` [Pa], ``areas`` [m²]; unloaded ones are dropped) with its
-    assumed patch."""
-    loaded = np.asarray(pressures) > 0.0
-    xy = np.asarray(xy, dtype=float)[loaded]
-    pressures = np.array(np.asarray(pressures, dtype=float)[loaded])
-    areas = np.array(np.asarray(areas, dtype=float)[loaded])
-    pressures.setflags(write=False)
-    areas.setflags(write=False)
+    """Compare the engine's ``patch`` of ``contact`` (unloaded polygons dropped) with its
+    assumed patch; ``at_onset`` is the engine's patch when the part started to slide."""
+    pressures, areas, xy = _loaded(patch)
     forces = pressures * areas
     total = float(forces.sum())
     field = pressure.points(xy, forces, centered=False)
-    assumed = assumed_pressure(contact.patch, xy)
-    peak = float(pressures.max())
-    deviation = (
-        None if assumed is None else float(np.max(np.abs(total * assumed - pressures)) / peak)
-    )
+    deviation = profile_deviation(contact.patch, xy, pressures, areas)
     engine_arm = LimitSurface(field, mu=1.0).max_moment
     assumed_arm = LimitSurface(contact.patch, mu=1.0).max_moment
+    use = None
+    if at_onset is not None and contact.mu > 0.0:
+        onset_pressures, onset_areas, onset_xy = _loaded(at_onset)
+        onset_field = pressure.points(onset_xy, onset_pressures * onset_areas, centered=False)
+        surface = LimitSurface(onset_field, mu=contact.mu, normal_force=at_onset.wrench[0])
+        use = float(1.0 / surface.safety_factor(at_onset.wrench[1:]))
     return ContactField(contact=contact.name, field=field, normal_force=total,
                         pressures=pressures, areas=areas, pressure_deviation=deviation,
-                        torsion_ratio=float(engine_arm / assumed_arm))  # fmt: skip
+                        torsion_ratio=float(engine_arm / assumed_arm), onset_use=use)  # fmt: skip
+
+
+def profile_deviation(
+    patch: pressure.PressureField, xy: np.ndarray, pressures: np.ndarray, areas: np.ndarray
+) -> float | None:
+    """The largest difference between pressures [Pa] at points ``xy`` [m] (polygons of
+    ``areas`` [m²]) and ``patch``'s pressure at their total force, over their peak [-];
+    ``None`` where ``patch`` has no pressure density."""
+    assumed = assumed_pressure(patch, xy)
+    if assumed is None:
+        return None
+    total = float(np.sum(pressures * areas))
+    return float(np.max(np.abs(total * assumed - pressures)) / np.max(pressures))
+
+
+def _loaded(patch: EnginePatch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Pressures [Pa], areas [m²] and centroids [m] of the polygons with positive pressure
+    (read-only arrays)."""
+    loaded = patch.pressures > 0.0
+    arrays = tuple(np.array(a[loaded], dtype=float) for a in (patch.pressures, patch.areas))
+    xy = np.array(patch.xy[loaded], dtype=float)
+    for array in (*arrays, xy):
+        array.setflags(write=False)
+    return (*arrays, xy)
 
 
 def assumed_pressure(patch: pressure.PressureField, xy: np.ndarray) -> np.ndarray | None:

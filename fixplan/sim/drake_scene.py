@@ -79,6 +79,28 @@ class Fingertip:
     patch_radius: float
 
 
+@dataclass(frozen=True, slots=True, kw_only=True)
+class EnginePatch:
+    """One contact's surface in the engine.
+
+    Attributes
+    ----------
+    xy : numpy.ndarray
+        ``(n, 2)``: polygon centroids in the contact's patch coordinates, about the contact point
+        along its ``t1, t2`` [m].
+    pressures, areas : numpy.ndarray
+        The pressure at each centroid [Pa] and the polygon's area [m²].
+    wrench : numpy.ndarray
+        ``(fn, ft1, ft2, mn)``: the force of the sphere on the part in the contact frame [N] and
+        its moment about the contact normal through the contact point [N m].
+    """
+
+    xy: np.ndarray
+    pressures: np.ndarray
+    areas: np.ndarray
+    wrench: np.ndarray
+
+
 def fingertip(patch_radius: float, normal_force: float) -> Fingertip:
     """The sphere of radius ``SPHERE_OVER_PATCH * patch_radius`` whose patch under
     ``normal_force`` [N] has radius ``patch_radius`` [m]."""
@@ -292,26 +314,38 @@ class DrakeScene:
         omega = velocity.rotational()
         return np.r_[velocity.translational() - np.cross(omega, origin), omega]
 
-    def patches(self) -> list[tuple[np.ndarray, np.ndarray, np.ndarray] | None]:
-        """Per contact, the engine's contact surface in patch coordinates: polygon centroids
-        ``(n, 2)`` [m] about the contact point along its ``t1, t2``, the pressure there [Pa] and
-        the polygons' areas [m²]; ``None`` where the contact is open."""
+    def patches(self) -> list[EnginePatch | None]:
+        """Per contact, the engine's contact surface and contact wrench (:class:`EnginePatch`);
+        ``None`` where the contact is open."""
         from fixplan.sim.drake_check import surface_polygons
 
         context = self.plant_context
         results = self.plant.get_contact_results_output_port().Eval(context)
         pose = self.plant.EvalBodyPoseInWorld(context, self.part)
-        inverse = pose.inverse()
+        inverse, rotation = pose.inverse(), pose.rotation().matrix()
         found = [None] * len(self.spheres)
         for index in range(results.num_hydroelastic_contacts()):
-            surface = results.hydroelastic_contact_info(index).contact_surface()
+            info = results.hydroelastic_contact_info(index)
+            surface = info.contact_surface()
             ids = (surface.id_M(), surface.id_N())
             contact_index = next(i for i, sphere in enumerate(self.spheres) if sphere in ids)
             contact = self.problem.contacts[contact_index]
             centroids, areas, pressures = surface_polygons(surface)
             in_part = np.array([inverse.multiply(c) for c in centroids]) + self.center
-            xy = (in_part - contact.position) @ contact.frame[:2].T
-            found[contact_index] = (xy, pressures, areas)
+            frame = contact.frame @ rotation.T  # t1, t2, n in the world
+            # F_Ac_W acts on the body of geometry M: the part when M is the pad.
+            sign = -1.0 if surface.id_M() == self.spheres[contact_index] else 1.0
+            spatial = info.F_Ac_W()
+            force, moment = sign * spatial.translational(), sign * spatial.rotational()
+            point = pose.multiply(contact.position - self.center)
+            moment = moment + np.cross(surface.centroid() - point, force)
+            t1, t2, n = frame
+            found[contact_index] = EnginePatch(
+                xy=(in_part - contact.position) @ contact.frame[:2].T,
+                pressures=pressures,
+                areas=areas,
+                wrench=np.array([force @ n, force @ t1, force @ t2, moment @ n]),
+            )
         return found
 
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from fixplan.errors import InvalidArgumentError
+from fixplan.errors import ConvergenceError, InvalidArgumentError
 from fixplan.planner.problem import Problem
 from fixplan.sim.drake_fields import ContactField, contact_field
 from fixplan.sim.validate import (
@@ -57,18 +57,21 @@ class DrakeCaseValidation(CaseValidation):
     fields : tuple of ContactField
         Per area contact, the engine's field at the planned forces and the task load (or at slip
         onset, if sooner) against the assumed profile.
-    exact_safety_factor : float
+    exact_safety_factor : float or None
         The case's safety factor at the planned forces with each area contact's model the exact
-        limit surface of its engine field [-].
+        limit surface of its engine field [-]; ``None`` when no multiple of the task load is
+        held so (the planned forces do not even hold the part under gravity).
     """
 
     fields: tuple[ContactField, ...]
-    exact_safety_factor: float
+    exact_safety_factor: float | None
 
     @property
     def exact_onset_ratio(self) -> float | None:
         """Drake's slip-onset multiple over ``exact_safety_factor``."""
         if self.onset is None or self.onset.onset_multiple is None:
+            return None
+        if self.exact_safety_factor is None:
             return None
         return self.onset.onset_multiple / self.exact_safety_factor
 
@@ -108,17 +111,18 @@ def validate(
             lowest = lower_end(problem, plan, name, factor)
             rate = (1.0 - lowest) / RAMP
             scene.start(factor * planned, task, lowest)
-            runs[key], _ = _run(scene, RAMP + HOLD, lowest, rate, 1.0, read_at=None)
+            runs[key], *_ = _run(scene, RAMP + HOLD, lowest, rate, 1.0, read_at=None)
         safety = float(plan.safety_factors[name])
         lowest = min(float(plan.held_intervals[name][0]), 1.0)
         reach = ONSET_REACH * safety if np.isfinite(safety) else 1.0
         scene.start(planned, task, lowest)
         seconds = ONSET_RAMP if np.isfinite(safety) else RAMP
-        onset, patches = _run(scene, seconds, lowest, (reach - lowest) / seconds, reach,
+        onset, patches, at_onset = _run(scene, seconds, lowest, (reach - lowest) / seconds, reach,
                               read_at=1.0)  # fmt: skip
+        at_onset = at_onset or [None] * len(problem.contacts)
         fields = tuple(
-            contact_field(contact, *patch)
-            for contact, patch in zip(problem.contacts, patches, strict=True)
+            contact_field(contact, patch, sliding)
+            for contact, patch, sliding in zip(problem.contacts, patches, at_onset, strict=True)
             if patch is not None and contact.patch is not None and contact.has_torsion
         )
         exact = exact_safety_factor(problem, plan, name, fields)
@@ -139,10 +143,12 @@ def validate(
     return found
 
 
-def exact_safety_factor(problem: Problem, plan, load: str, fields) -> float:
+def exact_safety_factor(problem: Problem, plan, load: str, fields) -> float | None:
     """The safety factor of case ``load`` at the plan's forces with each area contact of
     ``fields`` (:class:`ContactField`) modelled by the exact limit surface of its engine
-    field; ``nan`` if that check has no optimal answer."""
+    field; ``None`` if no multiple of the task load is held so.
+
+    Raises :class:`~fixplan.errors.ConvergenceError` if the planner fails on that check."""
     from fixplan.planner.planner import Planner
 
     case = plan.load_names.index(load)
@@ -159,17 +165,25 @@ def exact_safety_factor(problem: Problem, plan, load: str, fields) -> float:
     single = replace(problem, contacts=tuple(contacts), loads=(problem.loads[case],),
                      objective="check")  # fmt: skip
     checked = Planner(single).solve()
-    return float(checked.safety_factors[load]) if checked.status == "optimal" else float("nan")
+    if checked.status == "infeasible":
+        return None
+    if checked.status != "optimal":
+        raise ConvergenceError(
+            f"load case {load!r}: the check with the exact limit surfaces of Drake's fields "
+            f"ended {checked.status}: {'; '.join(checked.warnings) or 'no details'}"
+        )
+    return float(checked.safety_factors[load])
 
 
 def _run(scene, seconds: float, start: float, rate: float, reach: float, *, read_at):
     """Ramp the task load from ``start`` at ``rate`` [1/s] up to ``reach`` for ``seconds``;
     returns the :class:`Run` and, with ``read_at``, the engine's patches when the load reaches
-    that multiple or the part starts to slide."""
+    that multiple or the part starts to slide, and when it starts to slide (``None`` if it
+    does not)."""
     from fixplan.sim.drake_scene import TIME_STEP
 
     origin = previous = scene.slips()
-    onset_multiple = onset_twist = patches = None
+    onset_multiple = onset_twist = patches = at_onset = None
     history = [_sample(0.0, origin - origin, scene.rotation(), start)]
     settle = round(SETTLE / TIME_STEP)
     for step in range(1, round(seconds / TIME_STEP) + 1):
@@ -183,6 +197,7 @@ def _run(scene, seconds: float, start: float, rate: float, reach: float, *, read
             )
             if step >= settle and np.max(speed) / TIME_STEP > SLIP_SPEED:
                 onset_multiple, onset_twist = multiple, scene.twist()
+                at_onset = scene.patches() if read_at is not None else None
         previous = now
         if (
             read_at is not None
@@ -201,7 +216,7 @@ def _run(scene, seconds: float, start: float, rate: float, reach: float, *, read
     history = np.array(history)
     run = Run(displacement=float(history[-1, 1]), rotation=float(history[-1, 2]),
               onset_multiple=onset_multiple, onset_twist=onset_twist, history=history)  # fmt: skip
-    return run, patches
+    return run, patches, at_onset
 
 
 def _sample(time: float, slipped: np.ndarray, rotation: float, multiple: float) -> tuple:
