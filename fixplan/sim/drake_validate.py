@@ -22,6 +22,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from fixplan import validation
 from fixplan.errors import ConvergenceError, InvalidArgumentError
 from fixplan.planner.problem import Problem
 from fixplan.sim.drake_fields import ContactField, contact_field
@@ -93,54 +94,67 @@ def validate(
     cannot model (see :func:`~fixplan.sim.drake_scene.patch_size`) and
     :class:`~fixplan.errors.MissingExtraError` without the ``drake`` extra.
     """
-    from fixplan.sim.drake_scene import DrakeScene, patch_size, require_drake
+    from fixplan.sim.drake_scene import patch_size, require_drake
 
+    if not isinstance(problem, Problem):
+        raise InvalidArgumentError(f"problem must be a Problem, got {type(problem).__name__}")
     names = requested_cases(plan, margin, loads)
     for contact in problem.contacts:
         patch_size(contact)
     require_drake()
-    scale = problem_length_scale(problem) if length_scale is None else length_scale
+    scale = (
+        problem_length_scale(problem)
+        if length_scale is None
+        else validation.positive_scalar("length_scale", length_scale)
+    )
     found = []
     for done, name in enumerate(names):
-        case = plan.load_names.index(name)
-        planned = _planned_forces(problem, plan, case)
-        scene = DrakeScene(problem, _design_forces(plan, case))
-        task = _task_about_center(problem, case)
-        runs = {}
-        for key, factor in (("above", 1 + margin), ("below", 1 - margin)):
-            lowest = lower_end(problem, plan, name, factor)
-            rate = (1.0 - lowest) / RAMP
-            scene.start(factor * planned, task, lowest)
-            runs[key], *_ = _run(scene, RAMP + HOLD, lowest, rate, 1.0, read_at=None)
-        safety = float(plan.safety_factors[name])
-        lowest = min(float(plan.held_intervals[name][0]), 1.0)
-        reach = ONSET_REACH * safety if np.isfinite(safety) else 1.0
-        scene.start(planned, task, lowest)
-        seconds = ONSET_RAMP if np.isfinite(safety) else RAMP
-        onset, patches, at_onset = _run(scene, seconds, lowest, (reach - lowest) / seconds, reach,
-                              read_at=1.0)  # fmt: skip
-        at_onset = at_onset or [None] * len(problem.contacts)
-        fields = tuple(
-            contact_field(contact, patch, sliding)
-            for contact, patch, sliding in zip(problem.contacts, patches, at_onset, strict=True)
-            if patch is not None and contact.patch is not None and contact.has_torsion
-        )
-        exact = exact_safety_factor(problem, plan, name, fields)
-        motion = plan.motions.get(name) if plan.motions else None
-        onset = onset if np.isfinite(safety) else None
-        twist = onset.onset_twist if onset is not None else None
-        twist = runs["below"].onset_twist if twist is None else twist
-        angle = (
-            None if motion is None or twist is None else motion_angle(twist, motion.twist, scale)
-        )
-        found.append(DrakeCaseValidation(
-            load=name, planned_held=bool(plan.held[name]), safety_factor=safety,
-            above=runs["above"], below=runs["below"], onset=onset, motion_angle=angle,
-            fields=fields, exact_safety_factor=exact,
-        ))  # fmt: skip
+        found.append(_judge_case(problem, plan, name, margin, scale))
         if progress is not None:
             progress(done + 1, len(names))
     return found
+
+
+def _judge_case(
+    problem: Problem, plan, name: str, margin: float, scale: float
+) -> DrakeCaseValidation:
+    """The three runs of load case ``name``, its engine fields and its exact re-check."""
+    from fixplan.sim.drake_scene import DrakeScene
+
+    case = plan.load_names.index(name)
+    planned = _planned_forces(problem, plan, case)
+    scene = DrakeScene(problem, _design_forces(plan, case))
+    task = _task_about_center(problem, case)
+    runs = {}
+    for key, factor in (("above", 1 + margin), ("below", 1 - margin)):
+        lowest = lower_end(problem, plan, name, factor)
+        scene.start(factor * planned, task, lowest)
+        runs[key], *_ = _run(scene, RAMP + HOLD, lowest, (1.0 - lowest) / RAMP, 1.0, read_at=None)
+    # At the planned forces: the load ramped past the safety factor (to 1x where it is infinite,
+    # for the fields only).
+    safety = float(plan.safety_factors[name])
+    finite = bool(np.isfinite(safety))
+    lowest = min(float(plan.held_intervals[name][0]), 1.0)
+    reach, seconds = (ONSET_REACH * safety, ONSET_RAMP) if finite else (1.0, RAMP)
+    scene.start(planned, task, lowest)
+    onset, patches, at_onset = _run(scene, seconds, lowest, (reach - lowest) / seconds, reach,
+                                    read_at=1.0)  # fmt: skip
+    at_onset = at_onset or [None] * len(problem.contacts)
+    fields = tuple(
+        contact_field(contact, patch, sliding)
+        for contact, patch, sliding in zip(problem.contacts, patches, at_onset, strict=True)
+        if patch is not None and contact.patch is not None and contact.has_torsion
+    )
+    onset = onset if finite else None
+    motion = plan.motions.get(name) if plan.motions else None
+    twist = onset.onset_twist if onset is not None else None
+    twist = runs["below"].onset_twist if twist is None else twist
+    angle = None if motion is None or twist is None else motion_angle(twist, motion.twist, scale)
+    return DrakeCaseValidation(
+        load=name, planned_held=bool(plan.held[name]), safety_factor=safety,
+        above=runs["above"], below=runs["below"], onset=onset, motion_angle=angle,
+        fields=fields, exact_safety_factor=exact_safety_factor(problem, plan, name, fields),
+    )  # fmt: skip
 
 
 def exact_safety_factor(problem: Problem, plan, load: str, fields) -> float | None:
