@@ -127,7 +127,7 @@ def assumed_pressure(patch: pressure.PressureField, xy: np.ndarray) -> np.ndarra
         return _grid_pressure(patch, local)
     if isinstance(patch, pressure.FunctionField):
         shape = patch.shape
-        nodes, weights = shape._local_quadrature(pressure.DEFAULT_ORDER)
+        nodes, weights = shape.quadrature()  # the shape of a FunctionField has no pose
         area = np.pi * shape.radius**2 if isinstance(shape, pressure.DiskField) else shape.area
         integral = area * float(weights @ patch.pressure(nodes))
         inside = _disk_pressure(shape, local) > 0.0 if isinstance(shape, pressure.DiskField) else (

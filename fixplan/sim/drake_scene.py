@@ -6,8 +6,8 @@ r"""A planning problem, a plan's forces and a ramped task load as a Drake hydroe
 - Each contact is a rigid hydroelastic pad fixed to the part (a box whose outer face holds the
   contact point, normal along the contact normal) pressed by a compliant hydroelastic sphere:
   fixed to the world for locators and supports, on a prismatic joint along the normal for clamps
-  and fingers, pushed by a constant generalised force (the normal force plus the tip's weight
-  along the joint). Each sphere touches only its own pad; friction is the contact's ``mu``.
+  and fingers, pushed by a constant generalised force (the normal force, with the sphere's
+  weight along the joint compensated). Each sphere touches only its own pad; friction is the contact's ``mu``.
 - The sphere of an area contact is sized so that its patch under the normal force ``N`` the plan
   gives it is the contact's patch (:func:`fingertip`); a point contact gets a small stiff sphere
   of patch radius ``POINT_PATCH`` [m]. Spheres start at the depth that carries ``N``.
@@ -28,13 +28,11 @@ import numpy as np
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError, MissingExtraError
 from fixplan.planner.problem import Contact, Problem
+
+# The fingertip check's time step [s], friction regularisation [m/s] and dissipation [s/m].
+from fixplan.sim.drake_check import DISSIPATION, STICTION_TOLERANCE, TIME_STEP
 from fixplan.surface import pressure
 
-#: Discrete time step [s] and friction regularisation of the ``lagged`` approximation [m/s].
-TIME_STEP = 1e-3
-STICTION_TOLERANCE = 1e-6
-#: Hunt-Crossley dissipation of the spheres [s/m].
-DISSIPATION = 5.0
 #: Sphere radius over the radius of the patch it makes [-], and the sphere's mesh resolution
 #: hint over its radius [-].
 SPHERE_OVER_PATCH, RESOLUTION = 3.0, 1.0 / 8.0
@@ -104,6 +102,8 @@ class EnginePatch:
 def fingertip(patch_radius: float, normal_force: float) -> Fingertip:
     """The sphere of radius ``SPHERE_OVER_PATCH * patch_radius`` whose patch under
     ``normal_force`` [N] has radius ``patch_radius`` [m]."""
+    patch_radius = validation.positive_scalar("patch_radius", patch_radius)
+    normal_force = validation.positive_scalar("normal_force", normal_force)
     radius = SPHERE_OVER_PATCH * patch_radius
     d = np.sqrt(radius**2 - patch_radius**2)
     per_modulus = 2.0 * np.pi / radius * (radius * patch_radius**2 / 2.0 - (radius**3 - d**3) / 3.0)
