@@ -112,6 +112,7 @@ def test_the_command_line_runs_drake_and_reports_fields_and_exact_onsets(tmp_pat
         assert item["pressure_deviation"] > HERTZ_DEVIATION  # Hertz assumed, parabolic made
     report = (tmp_path / "report" / "report.md").read_text(encoding="utf-8")
     assert "Drake" in report and "exact s of the engine's fields" in report
+    assert "| load case | plan | safety factor | forces +10% | forces -10% |" in report
     assert (tmp_path / "report" / "case-1.png").is_file()
 
 

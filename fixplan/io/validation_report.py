@@ -103,6 +103,7 @@ def write_validation_report(
             (
                 "load case",
                 "plan",
+                "safety factor",
                 f"forces +{margin:.0%}",
                 f"forces -{margin:.0%}",
                 "slip onset / safety factor",
