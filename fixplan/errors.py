@@ -24,3 +24,7 @@ class ModelError(FixplanError, TypeError):
 
 class ConvergenceError(FixplanError, ArithmeticError):
     """An iterative computation did not reach its documented accuracy."""
+
+
+class MissingExtraError(FixplanError, ImportError):
+    """An optional extra (``pip install 'fixplan[...]'``) that a request needs is not installed."""

@@ -244,13 +244,16 @@ def _build_parser() -> argparse.ArgumentParser:
                         help="multiply the planned forces by this (default 1)")  # fmt: skip
 
     validate = _subcommand(
-        commands, "validate", "simulate a plan in MuJoCo: held at +margin, slips at -margin?",
+        commands, "validate",
+        "simulate a plan in MuJoCo or Drake: held at +margin, slips at -margin?",
         "fixplan validate problems/hertz-pinch.toml --margin 0.1 --report out/",
         _run_validate,
     )  # fmt: skip
     validate.add_argument("file", type=Path, help="problem file (TOML)")
-    validate.add_argument("--engine", choices=("mujoco",), default="mujoco",
-                          help="the physics engine (default mujoco)")  # fmt: skip
+    validate.add_argument("--engine", choices=("mujoco", "drake"), default="mujoco",
+                          help="the physics engine (default mujoco; drake: hydroelastic "
+                               "fingertips, their pressure fields and fixplan's exact limit "
+                               "surface of them)")  # fmt: skip
     validate.add_argument("--load", action="append", metavar="NAME",
                           help="validate this load case only (repeatable; default all)")  # fmt: skip
     validate.add_argument("--margin", type=float, default=0.1,
@@ -632,7 +635,13 @@ def _run_export(args: argparse.Namespace) -> tuple[int, str]:
 
 
 def _run_validate(args: argparse.Namespace) -> tuple[int, str]:
-    from fixplan.sim import validate as judge
+    if args.engine == "drake":
+        from fixplan.sim import drake_validate as judge
+        from fixplan.sim.drake_scene import require_drake
+
+        require_drake()
+    else:
+        from fixplan.sim import validate as judge
 
     problem_file, plan, failed = _planned(args)
     if failed:
@@ -644,13 +653,31 @@ def _run_validate(args: argparse.Namespace) -> tuple[int, str]:
     if args.report is not None:
         from fixplan.io.validation_report import write_validation_report
 
-        written = write_validation_report(args.report, problem_file, plan, cases, args.margin)
+        written = write_validation_report(args.report, problem_file, plan, cases, args.margin,
+                                          engine=args.engine)  # fmt: skip
         log.info("wrote %d report files to %s", len(written), args.report)
     code = EXIT_NOT_HELD if any(case.contradicts for case in cases) else EXIT_OK
     if args.json:
         return code, _json({"engine": args.engine, "margin": args.margin,
+                            "thresholds": _thresholds(args.engine),
                             "cases": [_case_document(case) for case in cases]})  # fmt: skip
-    return code, "\n".join(_validation_lines(problem_file, cases, args.margin))
+    return code, "\n".join(_validation_lines(problem_file, cases, args.margin, args.engine))
+
+
+def _thresholds(engine: str) -> dict:
+    """What the verdicts of a simulation check mean, in numbers."""
+    from fixplan.sim.validate import HELD_DISPLACEMENT, SLIP_SPEED
+
+    if engine == "drake":
+        from fixplan.sim import drake_scene
+
+        step = drake_scene.TIME_STEP
+    else:
+        from fixplan.sim.mjcf import OPTIONS
+
+        step = float(OPTIONS["timestep"])
+    return {"held_slip_m": HELD_DISPLACEMENT, "onset_speed_m_per_s": SLIP_SPEED,
+            "time_step_s": step}  # fmt: skip
 
 
 def _case_document(case) -> dict:
@@ -659,32 +686,66 @@ def _case_document(case) -> dict:
                                        "rotation_rad": r.rotation,
                                        "onset_multiple": r.onset_multiple}  # fmt: skip
 
-    return {"load": case.load, "planned_held": case.planned_held,
-            "safety_factor": case.safety_factor, "above": run(case.above),
-            "below": run(case.below), "onset": run(case.onset), "onset_ratio": case.onset_ratio,
-            "motion_angle_rad": case.motion_angle, "contradicts": case.contradicts}  # fmt: skip
+    document = {"load": case.load, "planned_held": case.planned_held,
+                "safety_factor": case.safety_factor, "above": run(case.above),
+                "below": run(case.below), "onset": run(case.onset),
+                "onset_ratio": case.onset_ratio, "motion_angle_rad": case.motion_angle,
+                "contradicts": case.contradicts}  # fmt: skip
+    if hasattr(case, "fields"):
+        document["exact_safety_factor"] = case.exact_safety_factor
+        document["exact_onset_ratio"] = case.exact_onset_ratio
+        document["fields"] = [
+            {"contact": item.contact, "normal_force_N": item.normal_force,
+             "polygons": item.polygons, "peak_pressure_Pa": item.peak_pressure,
+             "pressure_deviation": item.pressure_deviation, "torsion_ratio": item.torsion_ratio,
+             "onset_use": item.onset_use}
+            for item in case.fields
+        ]  # fmt: skip
+    return document
 
 
-def _validation_lines(problem_file, cases, margin: float) -> list[str]:
-    from fixplan.sim.validate import HELD_DISPLACEMENT
-
+def _validation_lines(problem_file, cases, margin: float, engine: str) -> list[str]:
+    thresholds = _thresholds(engine)
     up, down = f"+{margin:.0%}", f"-{margin:.0%}"
+    drake = engine == "drake"
     lines = [
-        f"problem    {problem_file.name}: {len(cases)} load cases simulated in MuJoCo",
-        f"held       no contact slips more than {HELD_DISPLACEMENT * 1e3:g} mm (its tip against "
-        "the part; area contacts: plus their turn times their radius) while the task load "
-        "ramps to 1x",
-        f"{'load case':28s} {'plan':>8s} {up:>8s} {down:>8s} {'onset/s':>8s} {'motion':>8s}",
-    ]
+        f"problem    {problem_file.name}: {len(cases)} load cases simulated in "
+        f"{'Drake (hydroelastic)' if drake else 'MuJoCo'}, "
+        f"{thresholds['time_step_s'] * 1e3:g} ms steps",
+        f"held       no contact slips more than {thresholds['held_slip_m'] * 1e3:g} mm (its tip "
+        "against the part; area contacts: plus their turn times their radius) while the task "
+        "load ramps to 1x",
+        f"onset      a contact slips faster than {thresholds['onset_speed_m_per_s'] * 1e3:g} mm/s"
+        + ("; s exact: fixplan's exact limit surface of the engine's pressure fields (none: "
+           "they do not hold the part at any multiple)" if drake else ""),
+        f"{'load case':28s} {'plan':>8s} {up:>8s} {down:>8s} {'onset/s':>8s} {'motion':>8s}"
+        + (f" {'s exact':>8s} {'onset/s exact':>13s}" if drake else ""),
+    ]  # fmt: skip
     for case in cases:
         ratio = "-" if case.onset_ratio is None else f"{case.onset_ratio:.3f}"
         angle = "-" if case.motion_angle is None else f"{math.degrees(case.motion_angle):.1f} deg"
         verdict = lambda run: "held" if run.held else "slips"  # noqa: E731
         note = "  <- the plan calls it held" if case.contradicts else ""
+        exact = ""
+        if drake:
+            exact_ratio = "-" if case.exact_onset_ratio is None else f"{case.exact_onset_ratio:.3f}"
+            held = "none" if case.exact_safety_factor is None else f"{case.exact_safety_factor:.4g}"
+            exact = f" {held:>8s} {exact_ratio:>13s}"
         lines.append(
             f"{case.load:28s} {'held' if case.planned_held else 'slips':>8s} "
-            f"{verdict(case.above):>8s} {verdict(case.below):>8s} {ratio:>8s} {angle:>8s}{note}"
+            f"{verdict(case.above):>8s} {verdict(case.below):>8s} {ratio:>8s} {angle:>8s}"
+            f"{exact}{note}"
         )
+        for item in case.fields if drake else ():
+            deviation = "-" if item.pressure_deviation is None else f"{item.pressure_deviation:.1%}"
+            use = (
+                "" if item.onset_use is None else f", at onset {item.onset_use:.3f} of its exact LS"
+            )
+            lines.append(
+                f"  field {item.contact}: {item.normal_force:.4g} N on {item.polygons} polygons, "
+                f"pressure off the assumed profile by {deviation} of its peak "
+                f"{item.peak_pressure / 1e6:.3g} MPa, torsion {item.torsion_ratio:.3f}x assumed{use}"
+            )
     return lines
 
 
@@ -1223,9 +1284,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_SOLVER
     except FixplanError as exc:
         print(f"fixplan: error: {exc}", file=sys.stderr)
-        # Errors about the input or the outputs asked for (a folder that cannot be written)
-        # derive from ValueError or OSError; any other is fixplan's own failure.
-        return EXIT_INVALID_INPUT if isinstance(exc, ValueError | OSError) else EXIT_UNEXPECTED
+        # Errors about the input, the outputs asked for (a folder that cannot be written) or an
+        # extra they need derive from ValueError, OSError or ImportError; any other is fixplan's
+        # own failure.
+        invalid = isinstance(exc, ValueError | OSError | ImportError)
+        return EXIT_INVALID_INPUT if invalid else EXIT_UNEXPECTED
     except KeyboardInterrupt:  # pragma: no cover
         return EXIT_UNEXPECTED
     except Exception as exc:

@@ -19,7 +19,7 @@ from fixplan.io.report_document import (
     inline,
     staged_folder,
 )
-from fixplan.sim.validate import HELD_DISPLACEMENT, CaseValidation
+from fixplan.sim.validate import HELD_DISPLACEMENT, SLIP_SPEED, CaseValidation
 
 #: Resolution of the figures [dots per inch].
 FIGURE_DPI = 110
@@ -67,8 +67,11 @@ def write_validation_report(
     plan,
     cases: Sequence[CaseValidation],
     margin: float,
+    *,
+    engine: str = "mujoco",
 ) -> list[Path]:
-    """Write the report of a simulation check into ``directory``; returns the files written."""
+    """Write the report of a simulation check by ``engine`` (``"mujoco"`` or ``"drake"``) into
+    ``directory``; returns the files written."""
     rows = []
     for case in cases:
         onset = "-" if case.onset_ratio is None else f"{case.onset_ratio:.4f}"
@@ -81,11 +84,12 @@ def write_validation_report(
         Heading(1, inline(f"Simulation check: {problem_file.name}")),
         Paragraph(
             inline(
-                f"MuJoCo {_mujoco_version()}, plan status {plan.status}, objective value "
+                f"{_engine_version(engine)}, plan status {plan.status}, objective value "
                 f"{plan.objective_value:.6g}; file SHA-256 {problem_file.sha256}. Held: no contact "
                 f"slips more than {HELD_DISPLACEMENT * 1e3:g} mm (its tip against the part; area "
                 "contacts: plus their turn about the normal times their radius) while the task "
-                "load ramps to 1× and is held."
+                "load ramps to 1× and is held. Slip onset: a contact slips faster than "
+                f"{SLIP_SPEED * 1e3:g} mm/s."
             )
         ),
         Paragraph(
@@ -99,6 +103,7 @@ def write_validation_report(
             (
                 "load case",
                 "plan",
+                "safety factor",
                 f"forces +{margin:.0%}",
                 f"forces -{margin:.0%}",
                 "slip onset / safety factor",
@@ -107,6 +112,8 @@ def write_validation_report(
             tuple(rows),
         ),
     ]
+    if engine == "drake":
+        blocks += _field_blocks(cases)
     for index, case in enumerate(cases, start=1):
         blocks.append(Image(f"case-{index}.png", f"load case {case.load}",
                             inline(f"Load case {case.load}: slip and rotation over time.")))  # fmt: skip
@@ -119,7 +126,66 @@ def write_validation_report(
     return [directory / name for name in names]
 
 
-def _mujoco_version() -> str:
+def _field_blocks(cases) -> list:
+    """Drake's pressure fields against the assumed profiles, and its onsets against fixplan's
+    exact limit surface of those fields."""
+    rows, fields = [], []
+    for case in cases:
+        ratio = "-" if case.exact_onset_ratio is None else f"{case.exact_onset_ratio:.4f}"
+        exact = (
+            "none held" if case.exact_safety_factor is None else f"{case.exact_safety_factor:.4g}"
+        )
+        rows.append((case.load, f"{case.safety_factor:.4g}", exact, ratio))
+        for item in case.fields:
+            deviation = "-" if item.pressure_deviation is None else f"{item.pressure_deviation:.1%}"
+            fields.append((case.load, item.contact, f"{item.normal_force:.4g}",
+                           str(item.polygons), f"{item.peak_pressure / 1e6:.3g}", deviation,
+                           f"{item.torsion_ratio:.3f}",
+                           "-" if item.onset_use is None else f"{item.onset_use:.3f}"))  # fmt: skip
+    return [
+        Heading(2, inline("Drake's pressure fields and fixplan's exact limit surface of them")),
+        Paragraph(
+            inline(
+                "Per case, the safety factor at the planned forces with each area contact's "
+                "model the exact limit surface of the field Drake produced, and Drake's slip "
+                "onset over it. Per area contact, that field (read when the task load reaches "
+                "1× at the planned forces, or at slip onset if sooner) against the profile the "
+                "plan assumed at the same normal force: the largest pressure difference at the "
+                "engine's polygons over its peak pressure, the largest friction moment per "
+                "unit mu N over the assumed patch's, and the shear and torsion the engine "
+                "applied there at slip onset as a fraction of the exact limit surface of its "
+                "field then."
+            )
+        ),
+        Table(
+            (
+                "load case",
+                "plan's safety factor",
+                "exact s of the engine's fields",
+                "slip onset / exact s",
+            ),
+            tuple(rows),
+        ),
+        Table(
+            (
+                "load case",
+                "contact",
+                "normal force [N]",
+                "polygons",
+                "peak pressure [MPa]",
+                "pressure off the assumed profile",
+                "torsion / assumed",
+            ),
+            tuple(fields),
+        ),
+    ]
+
+
+def _engine_version(engine: str) -> str:
+    if engine == "drake":
+        from importlib.metadata import version
+
+        return f"Drake {version('drake')} (hydroelastic contact, lagged approximation)"
     import mujoco
 
-    return mujoco.__version__
+    return f"MuJoCo {mujoco.__version__}"

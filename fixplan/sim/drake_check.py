@@ -302,7 +302,9 @@ class _Scene:
             self.scene_graph.GetMyContextFromRoot(self.context)
         )
         surfaces = query.ComputeContactSurfaces(HydroelasticContactRepresentation.kPolygon)
-        return sum(float(np.prod(_polygons(surface)[1:], axis=0).sum()) for surface in surfaces)
+        return sum(
+            float(np.prod(surface_polygons(surface)[1:], axis=0).sum()) for surface in surfaces
+        )
 
     def patch(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Polygon centroids relative to the fingertip's axis [m], their areas [m²] and the
@@ -314,7 +316,7 @@ class _Scene:
                 "raise normal_force or lower modulus"
             )
         surface = results.hydroelastic_contact_info(0).contact_surface()
-        centroids, areas, pressures = _polygons(surface)
+        centroids, areas, pressures = surface_polygons(surface)
         start = self.planar.position_start()
         axis = self.plant.GetPositions(self.plant_context)[start : start + 2]
         return centroids[:, :2] - axis, areas, pressures
@@ -344,7 +346,7 @@ class _Scene:
         return None
 
 
-def _polygons(surface) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def surface_polygons(surface) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Centroids [m], areas [m²] and the pressure at the centroids [Pa] of the polygons of a
     Drake contact surface."""
     mesh, field = surface.poly_mesh_W(), surface.poly_e_MN()

@@ -111,25 +111,14 @@ def validate(
     """Simulate every load case of ``plan`` (or those named in ``loads``) in MuJoCo;
     ``length_scale`` [m] weighs rotation against translation in the motion angle (default: the
     largest distance of a contact from the centre of mass)."""
-    if not 0.0 < margin < 1.0:
-        raise InvalidArgumentError(f"margin must be between 0 and 1, got {margin!r}")
-    if plan.status != "optimal" or plan.forces is None:
-        raise InvalidArgumentError(
-            f"only an optimal plan can be simulated; this one is {plan.status}"
-        )
-    names = list(plan.load_names) if loads is None else list(loads)
-    unknown = [name for name in names if name not in plan.load_names]
-    if unknown:
-        raise InvalidArgumentError(
-            f"unknown load case {unknown[0]!r}; the plan's are {', '.join(map(repr, plan.load_names))}"
-        )
-    scale = _length_scale(problem) if length_scale is None else length_scale
+    names = requested_cases(plan, margin, loads)
+    scale = problem_length_scale(problem) if length_scale is None else length_scale
     found = []
     for done, name in enumerate(names):
         safety = float(plan.safety_factors[name])
         runs = {}
         for key, factor in (("above", 1 + margin), ("below", 1 - margin)):
-            lowest = _lower_end(problem, plan, name, factor)  # where the ramp starts
+            lowest = lower_end(problem, plan, name, factor)  # where the ramp starts
             ramp = RAMP / (1.0 - lowest) if lowest < 1.0 else RAMP
             scene = to_mjcf(problem, plan, load=name, scale=factor, ramp=ramp, max_multiple=1.0,
                             start=lowest)  # fmt: skip
@@ -146,7 +135,9 @@ def validate(
         # The plan's motion is that at the top of the held interval: the onset run's slide.
         twist = onset.onset_twist if onset is not None else None
         twist = below.onset_twist if twist is None else twist
-        angle = None if motion is None or twist is None else _angle(twist, motion.twist, scale)
+        angle = (
+            None if motion is None or twist is None else motion_angle(twist, motion.twist, scale)
+        )
         found.append(CaseValidation(load=name, planned_held=bool(plan.held[name]),
                                     safety_factor=safety, above=above, below=below, onset=onset,
                                     motion_angle=angle))  # fmt: skip
@@ -155,7 +146,25 @@ def validate(
     return found
 
 
-def _lower_end(problem: Problem, plan, load: str, factor: float) -> float:
+def requested_cases(plan, margin: float, loads: list[str] | None) -> list[str]:
+    """The load cases to simulate (all of ``plan``'s, or ``loads``), once ``margin`` and the plan
+    are checked: an optimal plan with forces, a margin between 0 and 1, known case names."""
+    if not 0.0 < margin < 1.0:
+        raise InvalidArgumentError(f"margin must be between 0 and 1, got {margin!r}")
+    if plan.status != "optimal" or plan.forces is None:
+        raise InvalidArgumentError(
+            f"only an optimal plan can be simulated; this one is {plan.status}"
+        )
+    names = list(plan.load_names) if loads is None else list(loads)
+    unknown = [name for name in names if name not in plan.load_names]
+    if unknown:
+        raise InvalidArgumentError(
+            f"unknown load case {unknown[0]!r}; the plan's are {', '.join(map(repr, plan.load_names))}"
+        )
+    return names
+
+
+def lower_end(problem: Problem, plan, load: str, factor: float) -> float:
     """Where a run with the active forces of case ``load`` scaled by ``factor`` starts its ramp:
     the lower end of the held interval of those forces (at most 1), from the planner (a part
     that the forces alone push out, like a squeezed nose cone, is held only from there on)."""
@@ -264,13 +273,15 @@ def _twist(data) -> np.ndarray:
     return np.r_[data.qvel[:3] - np.cross(omega, data.qpos[:3]), omega]
 
 
-def _angle(simulated: np.ndarray, planned: np.ndarray, length_scale: float) -> float:
+def motion_angle(simulated: np.ndarray, planned: np.ndarray, length_scale: float) -> float:
+    """Angle [rad] between two twists ``(v, ω)`` compared as ``(v, length_scale ω)``."""
     weights = np.r_[np.ones(3), np.full(3, length_scale)]
     a, b = simulated * weights, np.asarray(planned, dtype=float) * weights
     cosine = float(a @ b / (np.linalg.norm(a) * np.linalg.norm(b)))
     return float(np.arccos(np.clip(cosine, -1.0, 1.0)))
 
 
-def _length_scale(problem: Problem) -> float:
+def problem_length_scale(problem: Problem) -> float:
+    """The largest distance of a contact from the centre of mass [m] (at least 1 mm)."""
     spread = [np.linalg.norm(c.position - problem.body.center_of_mass) for c in problem.contacts]
     return float(max(max(spread), 1e-3))
