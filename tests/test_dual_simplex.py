@@ -108,8 +108,53 @@ def test_planner_re_solves_through_the_simplex_equal_fresh_solves():
     for angle in np.linspace(0.0, 2.0, 4):  # cvxpy twice, then the direct path
         planner.solve([load(angle)])
     for angle in np.linspace(0.0, 6.0, 15):
-        plan = planner.solve([load(angle)], analyse=False)
-        fresh = Planner(_pyramid_grasp(load(angle))).solve(analyse=False)
+        plan = planner.solve([load(angle)])  # with the safety analysis: fixed-force programs
+        fresh = Planner(_pyramid_grasp(load(angle))).solve()
         assert plan.solver == "dual simplex (direct)"
         assert plan.status == fresh.status == "optimal"
         assert plan.objective_value == pytest.approx(fresh.objective_value, rel=1e-7)
+        low, high = plan.held_intervals["push"]
+        fresh_low, fresh_high = fresh.held_intervals["push"]
+        # The fresh solves are Clarabel's, which stops at duality gaps of about 1e-9 of its
+        # scaled problem: multiples agree to 1e-7.
+        assert high == pytest.approx(fresh_high, rel=1e-7)
+        assert low == pytest.approx(fresh_low, abs=1e-7)
+        # (Which contact is critical is a tie in these grasps: the optima are not unique.)
+        assert plan.utilisation.max() == pytest.approx(fresh.utilisation.max(), rel=1e-6)
+
+
+def test_a_program_whose_matrix_changes_is_solved_from_its_refactored_basis():
+    # One column of A changes, as the load column of a fixed-force objective does: small
+    # changes keep the basis dual feasible; every answer is HiGHS's.
+    rng = np.random.default_rng(11)
+    n, equalities = 12, 4
+    a, q, right_hand_side = _random_program(rng, n, equalities, 30)
+    b = right_hand_side(0.0)
+    simplex = DualSimplex(equalities, changing=True)
+    column = a[:, 0].copy()
+    for step in range(20):
+        a[: equalities + 30, 0] = column[: equalities + 30] * (1.0 + 0.01 * np.sin(step))
+        reference = _highs(a, b, q, equalities)
+        x, z = simplex.solve(a.copy(), q, b)
+        _assert_optimal(a, b, q, equalities, x, z, reference.fun)
+
+
+def test_a_changing_program_whose_warm_starts_keep_missing_is_left_to_the_caller():
+    rng = np.random.default_rng(5)
+    n, equalities = 10, 3
+    a, q, right_hand_side = _random_program(rng, n, equalities, 25)
+    b = right_hand_side(0.0)
+    simplex = DualSimplex(equalities, changing=True)
+    answers = []
+    for _ in range(40):
+        a[: equalities + 25] = rng.normal(size=(equalities + 25, n))  # a new program each time
+        b = right_hand_side(0.0)
+        b[: equalities + 25] = (
+            a[: equalities + 25] @ rng.normal(size=n)
+            + np.r_[np.zeros(equalities), rng.uniform(0.0, 1.0, size=25)]
+        )
+        found = simplex.solve(a.copy(), q, b)
+        if found is not None:
+            _assert_optimal(a, b, q, equalities, *found, _highs(a, b, q, equalities).fun)
+        answers.append(found is not None)
+    assert not any(answers[-10:])  # it stopped trying

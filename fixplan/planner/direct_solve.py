@@ -7,8 +7,8 @@ keeps the problem data as linear maps of the parameter vector with fixed sparsit
 loads and friction bounds of the contact-spring steps of :mod:`fixplan.motion.contact_springs`)
 and the linear cost ``q``. This module applies those maps itself, keeps one Clarabel solver whose
 ``A``, ``b`` and ``q`` are updated in place, and reads the variables and the multipliers of
-equality constraints from the solution vectors. Linear programs whose loads change only ``b``
-(pyramid models under a force objective) are solved by a warm-started dual simplex (:mod:`fixplan.planner.dual_simplex`) instead, with Clarabel where that
+equality constraints from the solution vectors. Linear programs (pyramid models) are solved by a
+warm-started dual simplex (:mod:`fixplan.planner.dual_simplex`) instead, with Clarabel where that
 gives up. It checks itself against cvxpy's answer when it
 is built and refuses (returns ``None``) where its assumptions do not hold (a parametric ``P``,
 cones Clarabel's direct path does not cover, cvxpy internals it does not recognise).
@@ -31,6 +31,9 @@ DENSE_MAX_ENTRIES = 20_000
 
 #: Linear programs up to this many constraint-matrix entries go to the dual simplex.
 SIMPLEX_MAX_ENTRIES = 100_000
+#: ... and, where ``A`` changes between solves (fixed-force objectives), up to this many
+#: variables (one load case of an 8-contact fixture has 28-35).
+SIMPLEX_MAX_CHANGING_VARIABLES = 64
 
 #: Clarabel's statuses of a problem without a feasible point.
 INFEASIBLE = ("PrimalInfeasible", "AlmostPrimalInfeasible")
@@ -46,11 +49,15 @@ class DirectSolver:
     def __init__(self, problem, solver, program, offsets, equalities, simplex=None):
         self._problem = problem
         self._solver = solver
-        self._simplex = simplex  # (DualSimplex, its dense A) or None
+        self._simplex = simplex
+        self._matrix = None  # the dense A of the simplex, while it does not change
         #: What solved the last problem: ``"dual simplex"`` or ``"CLARABEL"``.
         self.method = ""
         self._program = program
-        self._offsets = offsets
+        #: Where each variable sits in Clarabel's x: (id, start, stop, shape).
+        self._placement = [
+            (v.id, offsets[v.id], offsets[v.id] + v.size, v.shape) for v in problem.variables()
+        ]
         self._equalities = equalities
         self.objective_value = float("nan")
         #: Clarabel's status of the last solve.
@@ -85,11 +92,12 @@ class DirectSolver:
         # The offsets of the variables in Clarabel's x: those of the matrix stuffing, the last
         # reduction that sees variables (canonicalisation may add auxiliary ones before them).
         offsets = [d.var_offsets for d in inverse if hasattr(d, "var_offsets")][-1]
-        # Linear programs whose loads change b only (force objectives) go to the dual simplex.
-        linear = not dims.soc and program.quadratic.nnz == 0 and program.fixed_a
         simplex = None
-        if linear and len(b) * len(q) <= SIMPLEX_MAX_ENTRIES:
-            simplex = (DualSimplex(dims.zero), program.matrix(a).toarray())
+        small = len(b) * len(q) <= SIMPLEX_MAX_ENTRIES
+        if not program.fixed_a:  # cold starts cost more than Clarabel beyond this size
+            small = small and len(q) <= SIMPLEX_MAX_CHANGING_VARIABLES
+        if not dims.soc and program.quadratic.nnz == 0 and small:
+            simplex = DualSimplex(dims.zero, changing=not program.fixed_a)
         direct = cls(problem, solver, program, offsets, equalities, simplex)
         if not direct._agrees_with_cvxpy():
             return None
@@ -98,15 +106,15 @@ class DirectSolver:
     def solve(self, *, accept_inaccurate: bool = False) -> dict | None:
         """Variable values by id after a solve with the parameters' current values.
 
-        A linear program with a fixed ``A`` goes to the warm-started dual simplex first, and to
-        Clarabel where the simplex gives up (:mod:`fixplan.planner.dual_simplex`). ``None`` when Clarabel does not
+        A linear program goes to the warm-started dual simplex first, and to Clarabel where the
+        simplex gives up (:mod:`fixplan.planner.dual_simplex`). ``None`` when Clarabel does not
         report the problem solved (or almost solved, with ``accept_inaccurate``); :attr:`status`
         says why (use cvxpy then: it turns infeasibility into certificates).
         """
         vector = self._program.parameter_vector()
         q, constant = self._program.cost(vector)
         a, b = self._program.constraints(vector)
-        found = self._simplex_solve(q, b)
+        found = self._simplex_solve(q, a, b)
         if found is not None:
             x, self._dual = found
             value = float(q @ x)
@@ -125,20 +133,21 @@ class DirectSolver:
             value = float(solution.obj_val)
         value += constant  # of the minimisation cvxpy compiled
         self.objective_value = -value if isinstance(self._problem.objective, cp.Maximize) else value
-        values = {}
-        for variable in self._problem.variables():
-            start = self._offsets[variable.id]
-            chunk = x[start : start + variable.size]
-            values[variable.id] = chunk.reshape(variable.shape, order="F")
-        return values
+        return {
+            key: x[start:stop].reshape(shape, order="F")
+            for key, start, stop, shape in self._placement
+        }
 
-    def _simplex_solve(self, q, b) -> tuple[np.ndarray, np.ndarray] | None:
-        """``(x, z)`` from the dual simplex of a linear program whose ``A`` is fixed, or
-        ``None`` (not such a program, or the simplex gave up: Clarabel then solves it)."""
+    def _simplex_solve(self, q, a, b) -> tuple[np.ndarray, np.ndarray] | None:
+        """``(x, z)`` from the dual simplex of a linear program, or ``None`` (not a linear
+        program, or the simplex gave up: Clarabel then solves it)."""
         if self._simplex is None:
             return None
-        simplex, matrix = self._simplex
-        return simplex.solve(matrix, q, b)
+        matrix = self._matrix
+        if matrix is None:
+            matrix = self._program.dense(a)
+            self._matrix = matrix if self._program.fixed_a else None
+        return self._simplex.solve(matrix, q, b)
 
     def dual(self, constraint: cp.Constraint) -> np.ndarray | None:
         """The multipliers of equality ``constraint`` after :meth:`solve`, as cvxpy gives them
@@ -190,6 +199,7 @@ class _Program:
         self._split = int(indptr[-2])  # entries of A; the rest are b's, in the last column
         self._a_shape = (int(shape[0]), int(shape[1]) - 1)
         self._a_indptr = np.asarray(indptr[:-1])
+        self._dense_index = None  # (rows, columns) of A's entries, once dense() is asked
         #: Whether ``A`` does not depend on the parameters (only ``b`` and ``q`` change).
         self.fixed_a = a_map[:, : self._size - 1][: self._split].nnz == 0
         self._a_map = _for_products(a_map)
@@ -224,6 +234,15 @@ class _Program:
         b = np.zeros(self._a_shape[0])
         b[self._a_rows[self._split :]] = values[self._split :]
         return -values[: self._split], b
+
+    def dense(self, values) -> np.ndarray:
+        """Clarabel's ``A`` from its ``values``, as a dense array."""
+        if self._dense_index is None:
+            columns = np.repeat(np.arange(self._a_shape[1]), np.diff(self._a_indptr))
+            self._dense_index = (self._a_rows[: self._split], columns)
+        out = np.zeros(self._a_shape)
+        out[self._dense_index] = values
+        return out
 
     def matrix(self, values) -> sp.csc_matrix:
         """Clarabel's ``A`` from its ``values``."""

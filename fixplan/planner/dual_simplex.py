@@ -40,6 +40,9 @@ FEASIBILITY_RTOL = 1e-12
 OPTIMALITY_RTOL = 1e-10
 #: Pivots allowed per row of the program before the solve gives up (cycling).
 MAX_PIVOTS_PER_ROW = 4
+#: A program whose ``A`` changes is left to Clarabel once more than this fraction of at least
+#: ``WARM_TRIAL`` warm starts missed (each miss costs an artificial start).
+MAX_MISS_RATE, WARM_TRIAL = 0.25, 8
 #: The basis inverse is computed afresh after this many rank-one updates.
 REFACTOR_EVERY = 32
 
@@ -48,13 +51,20 @@ class DualSimplex:
     """Warm-started simplex for ``min q·x`` s.t. ``A x = b`` on the first ``equalities`` rows
     and ``A x <= b`` on the rest (``A`` dense: small programs only).
 
-    The optimal basis of each objective ``q`` is kept as the start of its next solve; ``A``
-    must not change between solves.
+    The optimal basis of each objective ``q`` is kept as the start of its next solve. Where
+    ``A`` changes (``changing``: the fixed-force objectives, whose task-load multiple multiplies
+    the load), the kept basis is refactored with the new ``A``; it is a start only if it is
+    still dual feasible (else the artificial start is), which small load changes (a control
+    loop) keep and large ones do not: once more than ``MAX_MISS_RATE`` of at least
+    ``WARM_TRIAL`` warm starts missed, the simplex stops trying for that objective (the caller's
+    Clarabel is then faster).
     """
 
-    def __init__(self, equalities: int):
+    def __init__(self, equalities: int, *, changing: bool = False):
         self._equalities = int(equalities)
+        self._changing = changing
         self._bases: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+        self._record: dict[bytes, tuple[int, int]] = {}  # warm starts tried and missed
         #: Pivots of the last solve.
         self.pivots = 0
 
@@ -64,11 +74,18 @@ class DualSimplex:
         """The optimal ``x`` ``(n,)`` and multipliers ``z`` ``(m,)`` (``q + A^T z = 0``,
         ``z >= 0`` on the inequalities, 0 off the active rows), or ``None`` (see the module)."""
         key = q.tobytes()
+        tried, missed = self._record.get(key, (0, 0))
+        if tried >= WARM_TRIAL and missed > MAX_MISS_RATE * tried:
+            return None
+        self.pivots = 0
         found = None
         if key in self._bases:
             rows, inverse = self._bases[key]
-            self.pivots = 0
-            found = self._pivot(a, q, b, rows.copy(), inverse.copy())
+            rows, inverse = rows.copy(), inverse.copy()
+            if not self._changing or _INVERT(a, rows, inverse):
+                found = self._pivot(a, q, b, rows, inverse)
+            if self._changing:
+                self._record[key] = (tried + 1, missed + (found is None))
         if found is None:
             found = self._cold(a, q, b)
         if found is None:
@@ -170,9 +187,13 @@ def dual_pivots(a, b, q, equalities, rows, inverse, x, z, limit, feasibility, op
             for j in range(n):
                 total -= inverse[j, k] * q[j]
             z_rows[k] = total
+        if pivots == 0 and since == 0:  # a start that is not dual feasible: no dual simplex
+            for k in range(n):
+                if rows[k] >= equalities and z_rows[k] < -optimality * q_size:
+                    return -1
         if entering < 0:
             if since > 0:  # confirm on a fresh inverse
-                if not invert(a, rows, inverse):
+                if not _INVERT(a, rows, inverse):
                     return -1
                 since = 0
                 continue
@@ -216,7 +237,7 @@ def dual_pivots(a, b, q, equalities, rows, inverse, x, z, limit, feasibility, op
         pivots += 1
         since += 1
         if since >= refactor:
-            if not invert(a, rows, inverse):
+            if not _INVERT(a, rows, inverse):
                 return -1
             since = 0
 
@@ -258,5 +279,5 @@ def invert(a, rows, inverse):  # pragma: no cover - compiled
     return True
 
 
-invert = compiled_scalar(invert)
+_INVERT = compiled_scalar(invert)
 _PIVOTS = compiled_scalar(dual_pivots)

@@ -52,19 +52,19 @@ class Verifier:
         normal, friction, scale = answer["normal"], answer["friction"], answer["scale"]
         sizes = np.empty((2, normal.shape[1]))
         ratios = np.empty((2, normal.shape[1]))
-        _EQUILIBRIUM(*self._maps, np.ascontiguousarray(normal), np.ascontiguousarray(friction),
-                     np.ascontiguousarray(wrenches), np.ascontiguousarray(scale, dtype=float),
-                     self._gravity, self._length_scale, sizes, ratios)  # fmt: skip
+        _EQUILIBRIUM(*self._maps, normal, friction, wrenches, scale, self._gravity,
+                     self._length_scale, sizes, ratios)  # fmt: skip
         problems = []
-        for row, unit in ((0, "N"), (1, "N m")):
-            worst = int(np.argmax(ratios[row]))
-            ratio, size = ratios[row, worst], sizes[row, worst]
-            if ratio > EQUILIBRIUM_RTOL:
-                problems.append(
-                    f"equilibrium residual of load case {worst + 1}: "
-                    f"{ratio * size:.3g} {unit}, over {EQUILIBRIUM_RTOL:g} of the "
-                    f"wrenches involved ({size:.3g} {unit})"
-                )
+        if ratios.max(initial=0.0) > EQUILIBRIUM_RTOL:
+            for row, unit in ((0, "N"), (1, "N m")):
+                worst = int(np.argmax(ratios[row]))
+                ratio, size = ratios[row, worst], sizes[row, worst]
+                if ratio > EQUILIBRIUM_RTOL:
+                    problems.append(
+                        f"equilibrium residual of load case {worst + 1}: "
+                        f"{ratio * size:.3g} {unit}, over {EQUILIBRIUM_RTOL:g} of the "
+                        f"wrenches involved ({size:.3g} {unit})"
+                    )
         relative = float(ratios.max(initial=0.0))
         known = answer.get("known_use")
         return relative, problems + self._friction_problems(normal, friction, known)
