@@ -22,6 +22,7 @@ import numpy as np
 from fixplan.planner.friction_use import FrictionUse
 from fixplan.planner.problem import Problem
 from fixplan.planner.screw import Screw
+from fixplan.surface.point_kernel import compiled_scalar
 from fixplan.tolerances import FRICTION_SET_RTOL, HELD_RTOL, MAX_SAFETY_FACTOR, MULTIPLE_ATOL
 
 
@@ -38,12 +39,10 @@ def analyse_cases(
     solves of every load case; ``staying`` projects the motions onto those that keep the
     contacts whose normal force the solve chose in contact."""
     names = tuple(load.name for load in problem.loads)
-    k_max = np.maximum(highest["scale"], 0.0)  # the solver may return -1e-19 for 0
-    k_max = np.where(k_max >= MAX_SAFETY_FACTOR * (1 - 1e-6), np.inf, k_max)
-    k_min = np.zeros_like(k_max) if lowest is None else np.maximum(lowest["scale"], 0.0)
-    k_min = np.where(k_min < MULTIPLE_ATOL, 0.0, k_min)
-    with np.errstate(divide="ignore"):
-        margin = np.minimum(k_max, np.where(k_min > 0.0, 1.0 / k_min, np.inf))
+    k_max = np.array(highest["scale"], dtype=float)
+    k_min = np.zeros_like(k_max) if lowest is None else np.array(lowest["scale"], dtype=float)
+    held = np.empty(len(k_max), dtype=np.bool_)
+    critical = _MULTIPLES(k_max, k_min, held, MAX_SAFETY_FACTOR, MULTIPLE_ATOL, HELD_RTOL)
     normal, friction, dual = highest["normal"], highest["friction"], highest.get("dual")
     motions = dict.fromkeys(names)
     if dual is not None:
@@ -57,9 +56,6 @@ def analyse_cases(
     noise = FRICTION_SET_RTOL * max(float(np.abs(normal).max()), 1e-12)
     known = highest.get("known_use")
     utilisation = np.minimum(friction_use(friction, normal, noise=noise, known=known), 1.0)
-    # Cases tied with the smallest margin (within solver accuracy): the first.
-    critical = int(np.flatnonzero(margin <= margin.min() * (1.0 + HELD_RTOL))[0])
-    held = (k_min <= 1.0 + HELD_RTOL) & (k_max >= 1.0 - HELD_RTOL)
     return {
         "safety_factors": dict(zip(names, k_max.tolist(), strict=True)),
         "safety_factor": float(k_max.min()),
@@ -101,7 +97,7 @@ class StayingInContact:
 
     def __call__(self, twists: np.ndarray, normal_forces: np.ndarray) -> np.ndarray:
         """The twists ``(6, K)`` kept in contact, at the normal forces ``(C, K)`` [N]."""
-        size = np.maximum(np.abs(normal_forces).max(axis=0, initial=0.0), 1e-300)
+        size = np.abs(normal_forces).max(axis=0, initial=1e-300)
         pressed = self._decided[:, None] & (normal_forces > FRICTION_SET_RTOL * size)
         out = np.array(twists, dtype=float)
         groups: dict[bytes, list[int]] = {}
@@ -111,8 +107,10 @@ class StayingInContact:
             projection = self._projection(key, pressed[:, cases[0]])
             if projection is None:
                 continue
-            projected = projection @ out[:, cases]
-            kept = np.linalg.norm(projected, axis=0) >= 0.5 * np.linalg.norm(out[:, cases], axis=0)
+            given = out[:, cases]
+            projected = projection @ given
+            # Kept where at least half the motion (in norm) remains: squared, a quarter.
+            kept = np.sum(projected * projected, axis=0) >= 0.25 * np.sum(given * given, axis=0)
             out[:, np.asarray(cases)[kept]] = projected[:, kept]
         return out
 
@@ -128,3 +126,25 @@ class StayingInContact:
                 projection = free.T @ free
             self._projections[key] = projection
         return self._projections[key]
+
+
+def multiples(k_max, k_min, held, cap, atol, held_rtol):  # pragma: no cover - compiled
+    """Clean the multiples of the two solves in place (solver noise below 0 and below
+    ``atol``, the ``cap`` as infinity), mark the held cases; the critical case: the first of
+    those tied (within ``held_rtol``) with the smallest margin ``min(k_max, 1 / k_min)``."""
+    margins = np.empty(k_max.shape[0])
+    for j in range(k_max.shape[0]):
+        high = max(k_max[j], 0.0)  # the solver may return -1e-19 for 0
+        k_max[j] = np.inf if high >= cap * (1 - 1e-6) else high
+        low = max(k_min[j], 0.0)
+        k_min[j] = 0.0 if low < atol else low
+        margins[j] = min(k_max[j], 1.0 / k_min[j] if k_min[j] > 0.0 else np.inf)
+        held[j] = k_min[j] <= 1.0 + held_rtol and k_max[j] >= 1.0 - held_rtol
+    smallest = margins.min()
+    for j in range(k_max.shape[0]):
+        if margins[j] <= smallest * (1.0 + held_rtol):
+            return j
+    return 0
+
+
+_MULTIPLES = compiled_scalar(multiples)
