@@ -1,9 +1,13 @@
 """The warm-started dual simplex against HiGHS (scipy's linprog), and in the planner."""
 
+import dataclasses
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.optimize import linprog
 
+from fixplan.io.problem_file import load_problem
 from fixplan.planner.dual_simplex import DualSimplex
 from fixplan.planner.planner import Planner
 from fixplan.planner.problem import Body, Contact, Load, Problem
@@ -158,3 +162,37 @@ def test_a_changing_program_whose_warm_starts_keep_missing_is_left_to_the_caller
             _assert_optimal(a, b, q, equalities, *found, _highs(a, b, q, equalities).fun)
         answers.append(found is not None)
     assert not any(answers[-10:])  # it stopped trying
+
+
+def test_a_linear_check_of_many_cases_equals_each_case_solved_alone():
+    # fixture-321 (pyramids) at its planned clamp forces, 30 turned load cases: solved one by
+    # one in an order of similar loads through the simplex (from the third solve on), and
+    # returned in the cases' own order.
+    problem = load_problem(Path(__file__).resolve().parents[1] / "problems" / "fixture-321.toml")
+    problem = problem.problem
+    forces = Planner(problem).solve().forces
+    contacts = tuple(
+        dataclasses.replace(c, force=float(forces[c.name])) if c.name in forces else c
+        for c in problem.contacts
+    )
+    rng = np.random.default_rng(2)
+    loads = []
+    for k in range(30):
+        base = problem.loads[k % len(problem.loads)]
+        angle = rng.uniform(-np.pi, np.pi)
+        c, s = np.cos(angle), np.sin(angle)
+        turn = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        loads.append(Load(name=f"case-{k}", force=turn @ base.force, point=turn @ base.point,
+                          torque=base.torque))  # fmt: skip
+    checked = dataclasses.replace(problem, contacts=contacts, loads=tuple(loads), objective="check")
+    planner = Planner(checked)
+    for _ in range(3):
+        plan = planner.solve()
+    assert "dual simplex" in plan.solver
+    for load in loads[::3]:
+        alone = Planner(dataclasses.replace(checked, loads=(load,))).solve()
+        low, high = plan.held_intervals[load.name]
+        alone_low, alone_high = alone.held_intervals[load.name]
+        assert high == pytest.approx(alone_high, rel=1e-7)
+        assert low == pytest.approx(alone_low, abs=1e-7)
+        assert plan.held[load.name] == alone.held[load.name]

@@ -51,6 +51,10 @@ class DirectSolver:
         self._solver = solver
         self._simplex = simplex
         self._matrix = None  # the dense A of the simplex, while it does not change
+        #: (column of the load multiple, its simplex) where only that column of A changes,
+        #: and the last matrix of that simplex with its b.
+        self._scaled = None
+        self._scaled_matrix = (None, None)
         #: What solved the last problem: ``"dual simplex"`` or ``"CLARABEL"``.
         self.method = ""
         self._program = program
@@ -99,6 +103,9 @@ class DirectSolver:
         if not dims.soc and program.quadratic.nnz == 0 and small:
             simplex = DualSimplex(dims.zero, changing=not program.fixed_a)
         direct = cls(problem, solver, program, offsets, equalities, simplex)
+        columns = program.parametric_columns()
+        if simplex is not None and len(columns) == 1:  # one load multiple times the loads
+            direct._scaled = (int(columns[0]), DualSimplex(dims.zero, changing=True))
         if not direct._agrees_with_cvxpy():
             return None
         return direct
@@ -147,7 +154,35 @@ class DirectSolver:
         if matrix is None:
             matrix = self._program.dense(a)
             self._matrix = matrix if self._program.fixed_a else None
+        if self._scaled is not None:
+            column = self._scaled[0]
+            if q[column] < 0.0 and np.count_nonzero(q) == 1:
+                return self._scaled_solve(matrix, q, b)
         return self._simplex.solve(matrix, q, b)
+
+    def _scaled_solve(self, matrix, q, b) -> tuple[np.ndarray, np.ndarray] | None:
+        r"""The largest load multiple ``k`` (column ``c``, cost ``q_c < 0``), through the
+        program in ``t = 1/k`` and ``y = x / k`` (Charnes and Cooper): dividing ``A x (=, <=) b``
+        by ``k`` gives ``A_rest y - b t (=, <=) -a_c``, whose matrix does not change with the
+        loads (they move to the right-hand side), so the basis of the last case starts the
+        next. Minimising ``|q_c| t`` gives ``k = 1/t``, ``x = y k``, and multipliers ``z' k``
+        (the same stationarity: ``a_c^T z' = |q_c| t``)."""
+        column, simplex = self._scaled
+        scaled, last = self._scaled_matrix
+        if not np.array_equal(b, last):  # the same object while b stays: no refactoring
+            scaled = matrix.copy()
+            scaled[:, column] = -b
+            self._scaled_matrix = (scaled, b.copy())
+        cost = np.zeros_like(q)
+        cost[column] = -q[column]
+        found = simplex.solve(scaled, cost, -matrix[:, column])
+        if found is None or found[0][column] <= 0.0:
+            return None
+        y, z = found
+        k = 1.0 / y[column]
+        x = y * k
+        x[column] = k
+        return x, z * k
 
     def dual(self, constraint: cp.Constraint) -> np.ndarray | None:
         """The multipliers of equality ``constraint`` after :meth:`solve`, as cvxpy gives them
@@ -201,7 +236,9 @@ class _Program:
         self._a_indptr = np.asarray(indptr[:-1])
         self._dense_index = None  # (rows, columns) of A's entries, once dense() is asked
         #: Whether ``A`` does not depend on the parameters (only ``b`` and ``q`` change).
-        self.fixed_a = a_map[:, : self._size - 1][: self._split].nnz == 0
+        parametric = a_map[: self._split][:, : self._size - 1]
+        self._parametric_entries = np.diff(parametric.tocsr().indptr) > 0
+        self.fixed_a = not self._parametric_entries.any()
         self._a_map = _for_products(a_map)
         if program.reduced_P is None or program.reduced_P.matrix_data is None:
             self.quadratic = sp.csc_matrix((self._variables, self._variables))
@@ -234,6 +271,12 @@ class _Program:
         b = np.zeros(self._a_shape[0])
         b[self._a_rows[self._split :]] = values[self._split :]
         return -values[: self._split], b
+
+    def parametric_columns(self) -> np.ndarray:
+        """The columns of ``A`` with entries that depend on the parameters."""
+        entries = np.flatnonzero(self._parametric_entries)
+        columns = np.repeat(np.arange(self._a_shape[1]), np.diff(self._a_indptr))
+        return np.unique(columns[entries])
 
     def dense(self, values) -> np.ndarray:
         """Clarabel's ``A`` from its ``values``, as a dense array."""

@@ -43,8 +43,9 @@ MAX_PIVOTS_PER_ROW = 4
 #: A program whose ``A`` changes is left to Clarabel once more than this fraction of at least
 #: ``WARM_TRIAL`` warm starts missed (each miss costs an artificial start).
 MAX_MISS_RATE, WARM_TRIAL = 0.25, 8
-#: The basis inverse is computed afresh after this many rank-one updates.
-REFACTOR_EVERY = 32
+#: The basis inverse is computed afresh after this many rank-one updates, and an optimum found
+#: after at least ``CONFIRM_AFTER`` of them is confirmed on a fresh one.
+REFACTOR_EVERY, CONFIRM_AFTER = 32, 8
 
 
 class DualSimplex:
@@ -63,7 +64,8 @@ class DualSimplex:
     def __init__(self, equalities: int, *, changing: bool = False):
         self._equalities = int(equalities)
         self._changing = changing
-        self._bases: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+        #: By objective: the basis, its inverse and the A it inverts.
+        self._bases: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self._record: dict[bytes, tuple[int, int]] = {}  # warm starts tried and missed
         #: Pivots of the last solve.
         self.pivots = 0
@@ -80,9 +82,9 @@ class DualSimplex:
         self.pivots = 0
         found = None
         if key in self._bases:
-            rows, inverse = self._bases[key]
+            rows, inverse, inverted = self._bases[key]
             rows, inverse = rows.copy(), inverse.copy()
-            if not self._changing or _INVERT(a, rows, inverse):
+            if inverted is a or np.array_equal(a, inverted) or _INVERT(a, rows, inverse):
                 found = self._pivot(a, q, b, rows, inverse)
             if self._changing:
                 self._record[key] = (tried + 1, missed + (found is None))
@@ -93,7 +95,7 @@ class DualSimplex:
         x, z, rows, inverse = found
         if len(self._bases) >= 8 and key not in self._bases:
             self._bases.clear()
-        self._bases[key] = (rows, inverse)
+        self._bases[key] = (rows, inverse, a if not self._changing else a.copy())
         return x, z
 
     def _cold(self, a, q, b):
@@ -136,7 +138,8 @@ class DualSimplex:
         x, z = np.empty(n), np.zeros(m)
         limit = MAX_PIVOTS_PER_ROW * (m + n)
         pivots = _PIVOTS(a, b, q, self._equalities, rows, inverse, x, z, limit,
-                            FEASIBILITY_RTOL, OPTIMALITY_RTOL, REFACTOR_EVERY)  # fmt: skip
+                            FEASIBILITY_RTOL, OPTIMALITY_RTOL, REFACTOR_EVERY,
+                            CONFIRM_AFTER)  # fmt: skip
         if pivots < 0:
             return None
         self.pivots += pivots
@@ -144,7 +147,7 @@ class DualSimplex:
 
 
 def dual_pivots(a, b, q, equalities, rows, inverse, x, z, limit, feasibility, optimality,
-                refactor):  # fmt: skip  # pragma: no cover - compiled
+                refactor, confirm):  # fmt: skip  # pragma: no cover - compiled
     """Dual simplex pivots from the dual feasible basis ``rows`` (with ``inverse``, both
     updated in place) until its vertex ``x`` is feasible; ``z`` gets the multipliers. Returns
     the number of pivots, or -1 (infeasible program, too many pivots, multipliers < 0, a
@@ -192,7 +195,7 @@ def dual_pivots(a, b, q, equalities, rows, inverse, x, z, limit, feasibility, op
                 if rows[k] >= equalities and z_rows[k] < -optimality * q_size:
                     return -1
         if entering < 0:
-            if since > 0:  # confirm on a fresh inverse
+            if since >= confirm:  # confirm on a fresh inverse
                 if not _INVERT(a, rows, inverse):
                     return -1
                 since = 0
