@@ -52,7 +52,8 @@ class DualSimplex:
     """Warm-started simplex for ``min q·x`` s.t. ``A x = b`` on the first ``equalities`` rows
     and ``A x <= b`` on the rest (``A`` dense: small programs only).
 
-    The optimal basis of each objective ``q`` is kept as the start of its next solve. Where
+    The optimal basis of each objective ``q`` is kept as the start of its next solve (with the
+    ``A`` it was found for, which the caller must not modify afterwards). Where
     ``A`` changes (``changing``: the fixed-force objectives, whose task-load multiple multiplies
     the load), the kept basis is refactored with the new ``A``; it is a start only if it is
     still dual feasible (else the artificial start is), which small load changes (a control
@@ -95,7 +96,7 @@ class DualSimplex:
         x, z, rows, inverse = found
         if len(self._bases) >= 8 and key not in self._bases:
             self._bases.clear()
-        self._bases[key] = (rows, inverse, a if not self._changing else a.copy())
+        self._bases[key] = (rows, inverse, a)
         return x, z
 
     def _cold(self, a, q, b):

@@ -39,11 +39,12 @@ SOLVERS = ("CLARABEL", "OSQP", "SCS")
 #: problems are mostly solved once, so there DPP does not pay.
 DPP_MAX_WORK = 5_000_000
 
-#: Load cases per compiled problem of the fixed-force objectives (their cases are independent).
+#: Load cases per compiled problem of the fixed-force objectives (their cases are independent)
+#: when Clarabel solves them; linear programs go one case at a time through the simplex.
 #: Clarabel's time per case grows with the block, the Python work per block falls: `check` of
-#: 1,000 cases of benchmarks/bench_planner.py, blocks of 1 / 4 / 16 / 64 cases: fixture-321
-#: (pyramids) 2,276 / 2,359 / 1,728 / 1,195 cases/s; the ellipsoid fixture (blocks of 1 / 4 / 8
-#: / 64) 3,021 / 3,930 / 3,615 / 3,102 cases/s.
+#: 1,000 cases of benchmarks/bench_planner.py through Clarabel, blocks of 1 / 4 / 16 / 64 cases:
+#: fixture-321 (pyramids) 2,276 / 2,359 / 1,728 / 1,195 cases/s; the ellipsoid fixture (blocks
+#: of 1 / 4 / 8 / 64) 3,021 / 3,930 / 3,615 / 3,102 cases/s.
 CASES_PER_BLOCK = 4
 
 _FALLBACK = {"CLARABEL": "SCS", "SCS": "CLARABEL", "OSQP": "CLARABEL"}
@@ -98,6 +99,7 @@ class Runner:
         self._built: dict[str, Stacked] = {}
         self._direct: dict[str, DirectSolver | None] = {}
         self._solves: dict[str, int] = {}
+        self._given: dict[str, tuple | None] = {}  # the given forces last set, if all scalars
         #: Whether the fixed-force programs are linear (pyramid models): their cases are then
         #: solved one by one, in an order of similar loads (see :meth:`run`).
         self.linear = all(_linear(model) for model in layout.models)
@@ -112,10 +114,12 @@ class Runner:
     def stacked(self, objective: str) -> Stacked:
         """The compiled problem of ``objective`` (built on first use)."""
         if objective not in self._built:
-            self._built[objective] = build(
+            stacked = build(
                 self.problem, self.layout, objective, self.block_size(objective),
                 squeeze=self.squeeze, switchable=self.switchable,
             )  # fmt: skip
+            assign(stacked.gravity, self.problem.body.weight_wrench)
+            self._built[objective] = stacked
         return self._built[objective]
 
     def run(
@@ -179,8 +183,10 @@ class Runner:
     ) -> dict:
         stacked = self.stacked(objective)
         assign(stacked.task, wrenches)
-        assign(stacked.gravity, self.problem.body.weight_wrench)
-        set_given(stacked, given, wrenches.shape[1])
+        scalars = tuple((i, float(v)) for i, v in given.items() if np.ndim(v) == 0)
+        if len(scalars) < len(given) or self._given.get(objective) != scalars:
+            set_given(stacked, given, wrenches.shape[1])  # (not again for the same forces)
+            self._given[objective] = scalars if len(scalars) == len(given) else None
         if stacked.sense is not None:
             assign(stacked.sense, float(sense))
         if stacked.unloaded is not None:
