@@ -147,7 +147,6 @@ def test_a_changing_program_whose_warm_starts_keep_missing_is_left_to_the_caller
     rng = np.random.default_rng(5)
     n, equalities = 10, 3
     a, q, right_hand_side = _random_program(rng, n, equalities, 25)
-    b = right_hand_side(0.0)
     simplex = DualSimplex(equalities, changing=True)
     answers = []
     for _ in range(40):

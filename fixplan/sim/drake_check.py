@@ -50,6 +50,22 @@ RAMP_START, RAMP_RATE, RAMP_END = 0.95, 0.5, 1.2
 PRESS_STEPS, PRESS_RTOL = 30, 1e-9
 
 
+def hydroelastic_plant(builder):
+    """A multibody plant and scene graph in ``builder`` (a Drake ``DiagramBuilder``) with
+    the contact of these checks: hydroelastic polygons, ``TIME_STEP``, the ``lagged``
+    approximation and ``STICTION_TOLERANCE``."""
+    from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig
+
+    config = MultibodyPlantConfig(
+        time_step=TIME_STEP,
+        contact_model="hydroelastic",
+        contact_surface_representation="polygon",
+        discrete_contact_approximation="lagged",
+        stiction_tolerance=STICTION_TOLERANCE,
+    )
+    return AddMultibodyPlant(config, builder)
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class DirectionResult:
     """Slip onset along one load direction.
@@ -214,24 +230,13 @@ class _Scene:
             Sphere,
         )
         from pydrake.math import RigidTransform
-        from pydrake.multibody.plant import (
-            AddMultibodyPlant,
-            CoulombFriction,
-            MultibodyPlantConfig,
-        )
+        from pydrake.multibody.plant import CoulombFriction
         from pydrake.multibody.tree import PlanarJoint, PrismaticJoint, SpatialInertia
         from pydrake.systems.analysis import Simulator
         from pydrake.systems.framework import DiagramBuilder
 
         builder = DiagramBuilder()
-        config = MultibodyPlantConfig(
-            time_step=TIME_STEP,
-            contact_model="hydroelastic",
-            contact_surface_representation="polygon",
-            discrete_contact_approximation="lagged",
-            stiction_tolerance=STICTION_TOLERANCE,
-        )
-        plant, scene_graph = AddMultibodyPlant(config, builder)
+        plant, scene_graph = hydroelastic_plant(builder)
         plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
         friction = CoulombFriction(mu, mu)
         plate = ProximityProperties()

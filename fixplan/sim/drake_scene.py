@@ -30,7 +30,7 @@ from fixplan.errors import InvalidArgumentError, MissingExtraError
 from fixplan.planner.problem import Contact, Problem
 
 # The fingertip check's time step [s], friction regularisation [m/s] and dissipation [s/m].
-from fixplan.sim.drake_check import DISSIPATION, STICTION_TOLERANCE, TIME_STEP
+from fixplan.sim.drake_check import DISSIPATION, TIME_STEP, hydroelastic_plant
 from fixplan.surface import pressure
 
 #: Sphere radius over the radius of the patch it makes [-], and the sphere's mesh resolution
@@ -166,7 +166,6 @@ class DrakeScene:
 
     def __init__(self, problem: Problem, design_forces: np.ndarray):
         from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
-        from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlantConfig
         from pydrake.multibody.tree import RotationalInertia, SpatialInertia
         from pydrake.systems.analysis import Simulator
         from pydrake.systems.framework import DiagramBuilder
@@ -179,14 +178,7 @@ class DrakeScene:
                 f"design_forces must be positive normal forces [N], got {design_forces.tolist()}"
             )
         builder = DiagramBuilder()
-        config = MultibodyPlantConfig(
-            time_step=TIME_STEP,
-            contact_model="hydroelastic",
-            contact_surface_representation="polygon",
-            discrete_contact_approximation="lagged",
-            stiction_tolerance=STICTION_TOLERANCE,
-        )
-        plant, scene_graph = AddMultibodyPlant(config, builder)
+        plant, scene_graph = hydroelastic_plant(builder)
         body = problem.body
         massive = body.mass > 0.0
         plant.mutable_gravity_field().set_gravity_vector(body.gravity if massive else np.zeros(3))
