@@ -25,9 +25,11 @@ from scipy.optimize import brentq
 from scipy.special import ellipe, ellipk
 
 from fixplan import Body, Contact, LimitSurface, Load, Problem, pressure
+from fixplan.planner import osculating as osculating_rounds
+from fixplan.planner import runner
 from fixplan.planner.contact_models import contact_model
 from fixplan.planner.planner import Planner
-from fixplan.tolerances import EXACT_CUT_RTOL
+from fixplan.tolerances import EXACT_CUT_RTOL, FRICTION_SET_RTOL
 
 R, MU, HALF_GAP = 0.01, 0.5, 0.04
 OPTIMUM_RTOL = 1e-7
@@ -76,10 +78,12 @@ def pinch(load: Load, objective: str = "min-max-normal-force", force=None) -> Pr
 
 
 def assert_loads_inside_their_exact_surfaces(problem: Problem, plan) -> None:
+    """Every pressed contact's load is inside its exact surface; normal forces below the
+    solver's noise (``FRICTION_SET_RTOL`` of the largest) carry no meaningful load direction."""
     for i, contact in enumerate(problem.contacts):
         surface = contact_model(contact).surface  # at unit normal force
         for fn, load in zip(plan.normal_forces[i], plan.contact_wrenches[i, :, 1:], strict=True):
-            if fn > 1e-9 * plan.normal_forces.max():
+            if fn > FRICTION_SET_RTOL * plan.normal_forces.max():
                 assert 1.0 / surface.safety_factor(load / fn) - 1.0 <= EXACT_CUT_RTOL
 
 
@@ -178,22 +182,123 @@ def test_re_solves_keep_every_contact_load_inside_its_exact_surface():
         np.testing.assert_allclose(plan.normal_forces[:, 0], expected, rtol=OPTIMUM_RTOL)
 
 
-def test_the_impending_motion_of_each_pinching_finger_is_the_normal_at_its_load():
+@pytest.mark.parametrize("osculating", [True, False])
+def test_the_impending_motion_of_each_pinching_finger_is_the_normal_at_its_load(
+    osculating, monkeypatch
+):
     # Normality: at the optimum each finger's twist in the impending motion (the equilibrium's
-    # multipliers mapped to the contact, which centre the tilted cuts) is the outward normal of
-    # its exact surface at its load, i.e. the load's sliding twist from the inverse map.
+    # multipliers mapped to the contact) is the outward normal of its exact surface at its load,
+    # i.e. the load's sliding twist from the inverse map; with osculating ellipsoids and with
+    # cutting planes alone.
+    if not osculating:
+        monkeypatch.setattr(runner, "smooth", lambda models: False)
     load = Load(name="hold", force=[0, 0, -10.0], point=[0, 0, 0], torque=[0, 0.1, 0])
     problem = pinch(load)
     planner = Planner(problem)
     plan = planner.solve(analyse=False)
     assert plan.status == "optimal"
-    twists = planner._runner.stacked(problem.objective).cuts.motion_twists()[:, 0]
+    stacked = planner._runner.stacked(problem.objective, osculating)
+    dual = np.asarray(stacked.balance.dual_value)[:, 0]
     scale = np.array([1.0, 1.0, R])  # normalised twist coordinates of the disk
     for i, contact in enumerate(problem.contacts):
+        twist = -planner.layout.friction_map[:, planner.layout.slices[i]].T @ dual
         surface = contact_model(contact).surface
         sliding = surface.motion(plan.contact_wrenches[i, 0, 1:] / plan.normal_forces[i, 0])
-        a, b = twists[i] * scale, sliding * scale
+        a, b = twist * scale, sliding * scale
         assert np.dot(a, b) / (np.linalg.norm(a) * np.linalg.norm(b)) > 1.0 - 1e-6
+
+
+def milling_fixture(model: str, seed: int) -> Problem:
+    """A block on two disk pads and a rectangular locator, two clamps, 6 random milling loads."""
+    rng = np.random.default_rng(seed)
+    pads = [
+        ("pad-a", "support", [-0.04, -0.03, 0], [0, 0, 1], pressure.disk(R)),
+        ("pad-b", "support", [0.04, -0.03, 0], [0, 0, 1], pressure.disk(R)),
+        ("pad-c", "support", [0.0, 0.04, 0], [0, 0, 1], pressure.rectangle(0.02, 0.01)),
+        ("side", "locator", [-0.06, 0, 0.02], [1, 0, 0], pressure.disk(0.008)),
+        ("clamp-top", "clamp", [0, 0, 0.04], [0, 0, -1], pressure.disk(0.006)),
+        ("clamp-side", "clamp", [0.06, 0, 0.02], [-1, 0, 0], pressure.disk(0.006)),
+    ]
+    contacts = [
+        Contact(name=name, role=role, position=p, normal=n, mu=0.3, model=model, patch=patch)
+        for name, role, p, n, patch in pads
+    ]
+    loads = [
+        Load(name=f"cut-{k}", force=rng.normal(0, 40, 3), point=[0, 0, 0.03],
+             torque=rng.normal(0, 0.5, 3))
+        for k in range(6)
+    ]  # fmt: skip
+    return Problem(body=Body(mass=1.0, center_of_mass=[0, 0, 0.02]), contacts=contacts,
+                   loads=loads, objective="min-total-clamp-force")  # fmt: skip
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_osculating_ellipsoids_find_the_optimum_of_the_cutting_planes(seed, monkeypatch):
+    """The two ways of stating exact models agree: the cutting planes (relaxations, exact when
+    every load is inside) and the osculating ellipsoids (stopped by the optimality conditions),
+    on a fixture of disk and rectangle patches, first solve and re-solve with new loads."""
+    problem = milling_fixture("exact", seed)
+    osculating = Planner(problem)
+    first = osculating.solve()
+    again = osculating.solve(milling_fixture("exact", seed + 10).loads)
+    assert osculating._runner.osculating
+    assert (problem.objective, False) not in osculating._runner._built  # no fallback
+    monkeypatch.setattr(runner, "smooth", lambda models: False)
+    cutting = Planner(problem)
+    assert not cutting._runner.osculating
+    expected = [cutting.solve(), cutting.solve(milling_fixture("exact", seed + 10).loads)]
+    for plan, reference in zip([first, again], expected, strict=True):
+        assert plan.status == reference.status == "optimal"
+        assert plan.objective_value == pytest.approx(reference.objective_value, rel=OPTIMUM_RTOL)
+        assert plan.safety_factor == pytest.approx(reference.safety_factor, rel=1e-6)
+        assert_loads_inside_their_exact_surfaces(problem, plan)
+
+
+def test_rounds_that_do_not_settle_leave_the_problem_to_the_cutting_planes(monkeypatch):
+    monkeypatch.setattr(osculating_rounds, "MAX_ROUNDS", 1)
+    load = Load(name="hold", force=[0, 0, -10.0], point=[0, 0, 0], torque=[0, 0.2, 0])
+    problem = pinch(load)
+    planner = Planner(problem)
+    plan = planner.solve(analyse=False)
+    assert (problem.objective, False) in planner._runner._built
+    expected, _ = least_normal_force(5.0, 0.1)
+    assert plan.status == "optimal"
+    np.testing.assert_allclose(plan.normal_forces[:, 0], expected, rtol=OPTIMUM_RTOL)
+
+
+def test_an_infeasible_exact_problem_is_certified_by_the_cutting_planes():
+    # Fingers limited to 5 N cannot hold a 20 N weight at mu = 0.5: the ellipsoids' solve is
+    # infeasible, and so is the cutting planes' relaxation, which proves it.
+    contacts = [
+        Contact(name=name, role="finger", position=[0, side * HALF_GAP, 0], normal=[0, -side, 0],
+                mu=MU, model="exact", patch=pressure.disk(R), max_force=5.0)
+        for name, side in (("left", -1), ("right", 1))
+    ]  # fmt: skip
+    load = Load(name="hold", force=[0, 0, -20.0], point=[0, 0, 0])
+    problem = Problem(body=Body(mass=0.0, center_of_mass=[0, 0, 0]), contacts=contacts,
+                      loads=[load], objective="min-max-normal-force")  # fmt: skip
+    planner = Planner(problem)
+    plan = planner.solve()
+    assert plan.status == "infeasible"
+    assert (problem.objective, False) in planner._runner._built
+
+
+def test_point_supports_take_the_cutting_planes():
+    # Facets have no curvature to osculate.
+    patch = pressure.points([[0.01, 0.0], [-0.01, 0.0], [0.0, 0.01]], [1.0, 1.0, 1.0])
+    contacts = [
+        Contact(name=name, role="finger", position=[0, side * HALF_GAP, 0], normal=[0, -side, 0],
+                mu=MU, model="exact", patch=patch)
+        for name, side in (("left", -1), ("right", 1))
+    ]  # fmt: skip
+    load = Load(name="hold", force=[0, 0, -10.0], point=[0, 0, 0], torque=[0, 0.05, 0])
+    problem = Problem(body=Body(mass=0.0, center_of_mass=[0, 0, 0]), contacts=contacts,
+                      loads=[load], objective="min-max-normal-force")  # fmt: skip
+    planner = Planner(problem)
+    assert not planner._runner.osculating
+    plan = planner.solve()
+    assert plan.status == "optimal"
+    assert_loads_inside_their_exact_surfaces(problem, plan)
 
 
 def test_the_uses_kept_from_the_last_cutting_round_are_those_of_the_final_loads():

@@ -11,9 +11,12 @@ included). As convex constraints the set is an intersection of infinitely many h
 the model states a finite subset of them: the tangent planes at ``SEED_PLANES`` evenly spread
 twists (:meth:`Exact.conic_form`, an outer polytope, homogeneous in ``N``), and :meth:`Exact.cut`
 gives the tangent plane at the ray of any load, the cut that removes that load when it lies
-outside. The planner adds such cuts until every contact load lies inside its exact surface
-(:mod:`fixplan.planner.cuts`); used on its own, :meth:`constraints` states the seed polytope
-only, which holds the exact set (:attr:`Exact.constraint_error` says by how much).
+outside. :meth:`Exact.osculating` gives the ellipsoid with the set's point, tangent plane and
+curvature on the ray of any load. The planner moves such ellipsoids
+(:mod:`fixplan.planner.osculating`) or adds such cuts (:mod:`fixplan.planner.cuts`) until every
+contact load lies inside its exact surface at the exact optimum; used on its own,
+:meth:`constraints` states the seed polytope only, which holds the exact set
+(:attr:`Exact.constraint_error` says by how much).
 
 A frictionless contact keeps the shape of its patch (:attr:`LimitSurface.friction_shape`):
 its set is the load 0 and its motion the limit ``mu → 0+`` (:mod:`fixplan.models.base`).
@@ -130,10 +133,58 @@ class Exact(FrictionModel):
         support is read from the inverse map's answer instead of being integrated again
         (relative difference about 1e-14, far below the planner's ``CUT_MARGIN``).
         """
+        excess, planes = self._cut_terms(loads)
+        return planes, excess
+
+    def osculating(self, loads: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        r"""The ellipsoid that osculates the exact set where the ray of each load meets it.
+
+        Parameters
+        ----------
+        loads : numpy.ndarray
+            ``(K, 3)`` loads ``(fx, fy, m)`` per unit normal force [-, -, m], nonzero.
+
+        Returns
+        -------
+        excess : numpy.ndarray
+            ``(K,)`` ``1 / s - 1`` for the exact safety factor ``s`` of each load.
+        points : numpy.ndarray
+            ``(K, 3)`` the surface points ``u = s q`` on the loads' rays.
+        factors : numpy.ndarray
+            ``(K, 3, 3)`` upper triangular ``R`` [-, -, 1/m]: the ellipsoid
+            :math:`\lVert R L \rVert \le N` has the exact surface's point ``u``, tangent plane
+            and curvature there (non-finite where the surface has no curvature: at a facet).
+
+        Notes
+        -----
+        With ``a = V / h_1(V)`` the tangent plane at ``u`` (``V`` its sliding twist) and
+        ``J = ∇²h_1(a)`` (``J a = 0``), the gauge ``g`` of the set (``g(u) = 1``, ``∇g(u) = a``)
+        has the Hessian ``∇²g(u) = (I - a uᵀ) J⁺ (I - u aᵀ)``: differentiate ``∇g(∇h_1(V)) =
+        V / h_1(V)``. The ellipsoid's gauge ``√(qᵀ Q q)`` with ``Q = ∇²g(u) + a aᵀ = RᵀR`` has
+        the same value, gradient and Hessian at ``u``. The algebra runs in normalised
+        coordinates (loads over :meth:`_units`), where ``J`` is well conditioned.
+        """
+        excess, planes = self._cut_terms(loads)
+        units = self._units()
+        points = loads / (1.0 + excess)[:, None]
+        a, u = planes * units, points / units  # normalised plane and point, a · u = 1
+        curvature = self.surface.support_hessian(planes) / self.surface.normal_force
+        curvature /= units[None, :, None] * units[None, None, :]
+        axis = a / np.linalg.norm(a, axis=1, keepdims=True)
+        along = axis[:, :, None] * axis[:, None, :]
+        inverse = np.linalg.inv(curvature + along) - along  # J⁺: J has the null vector a
+        away = np.eye(3) - a[:, :, None] * u[:, None, :]
+        shape = away @ inverse @ away.transpose(0, 2, 1) + a[:, :, None] * a[:, None, :]
+        with np.errstate(invalid="ignore"):
+            factors = np.linalg.cholesky(0.5 * (shape + shape.transpose(0, 2, 1)))
+        return excess, points, factors.transpose(0, 2, 1) / units[None, None, :]
+
+    def _cut_terms(self, loads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Excess ``1 / s - 1`` and tangent planes ``V / h_1(V)`` of loads ``(K, 3)``."""
         twists, safety = self.surface.motion_and_safety_factor(loads * self.surface.normal_force)
         twists, safety = np.atleast_2d(twists), np.atleast_1d(safety)
         support = safety * np.einsum("ij,ij->i", loads, twists)
-        return twists / support[:, None], 1.0 / safety - 1.0
+        return 1.0 / safety - 1.0, twists / support[:, None]
 
     def planes(self, twists: np.ndarray) -> np.ndarray:
         r"""Tangent planes :math:`a \cdot L \le N`, ``a = V / h_1(V)``, of the exact set at the

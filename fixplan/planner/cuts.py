@@ -1,5 +1,9 @@
 r"""Exact friction models in the planner: tangent-plane cuts added until every load is inside.
 
+The planner takes this way where osculating ellipsoids (:mod:`fixplan.planner.osculating`) do
+not apply or do not settle: surfaces with facets, solvers other than Clarabel, infeasible
+problems (a relaxation proves them infeasible).
+
 The set of an :class:`~fixplan.models.Exact` model is the intersection of the halfspaces
 ``L · V <= N h_1(V)`` over all twists ``V``. Its constraints state a seed polytope of such planes
 (an outer approximation); a solve then gives contact loads ``ℓ_ij`` at normal forces ``n_ij``
@@ -121,7 +125,7 @@ class CutPool:
             cp.multiply(parameter, tile @ friction[self._rows[:, axis], :])
             for axis, parameter in enumerate(self._parameters)
         )
-        self.constraint = lhs <= tile @ normal[self._contacts, :]
+        self.constraints = [lhs <= tile @ normal[self._contacts, :]]
 
     @classmethod
     def of(cls, models, slices, normal, friction, *, wrenches, balance) -> CutPool | None:

@@ -18,6 +18,7 @@ import numpy as np
 
 from fixplan.errors import FixplanError, InvalidArgumentError
 from fixplan.planner.direct_solve import DirectSolver
+from fixplan.planner.osculating import OsculatingPool, smooth
 from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, Problem
 from fixplan.planner.stacking import (
     ContactLayout,
@@ -96,10 +97,18 @@ class Runner:
         self.solver = solver
         self.squeeze = squeeze
         self.switchable = switchable
-        self._built: dict[str, Stacked] = {}
-        self._direct: dict[str, DirectSolver | None] = {}
-        self._solves: dict[str, int] = {}
-        self._given: dict[str, tuple | None] = {}  # the given forces last set, if all scalars
+        # Compiled problems and their direct solvers, keyed by (objective, osculating).
+        self._built: dict[tuple, Stacked] = {}
+        self._direct: dict[tuple, DirectSolver | None] = {}
+        self._solves: dict[tuple, int] = {}
+        self._given: dict[tuple, tuple | None] = {}  # the given forces last set, if all scalars
+        #: Smooth exact models are first solved with osculating ellipsoids, conic programs that
+        #: Clarabel solves (:mod:`fixplan.planner.osculating`); the cutting planes take over
+        #: where those rounds do not settle.
+        self.osculating = solver == "CLARABEL" and smooth(layout.models)
+        self._layouts = {False: layout}
+        if self.osculating:
+            self._layouts[True] = ContactLayout.of(problem, list(layout.models), osculating=True)
         #: Whether the fixed-force programs are linear (pyramid models): their cases are then
         #: solved one by one, in an order of similar loads (see :meth:`run`).
         self.linear = all(_linear(model) for model in layout.models)
@@ -111,16 +120,18 @@ class Runner:
             return cases
         return 1 if self.linear and self.solver == "CLARABEL" else min(cases, CASES_PER_BLOCK)
 
-    def stacked(self, objective: str) -> Stacked:
-        """The compiled problem of ``objective`` (built on first use)."""
-        if objective not in self._built:
+    def stacked(self, objective: str, osculating: bool = False) -> Stacked:
+        """The compiled problem of ``objective`` (built on first use), with the exact contacts'
+        osculating ellipsoids or (default) their cutting planes."""
+        key = (objective, osculating)
+        if key not in self._built:
             stacked = build(
-                self.problem, self.layout, objective, self.block_size(objective),
+                self.problem, self._layouts[osculating], objective, self.block_size(objective),
                 squeeze=self.squeeze, switchable=self.switchable,
             )  # fmt: skip
             assign(stacked.gravity, self.problem.body.weight_wrench)
-            self._built[objective] = stacked
-        return self._built[objective]
+            self._built[key] = stacked
+        return self._built[key]
 
     def run(
         self,
@@ -181,63 +192,79 @@ class Runner:
     def _run_block(
         self, objective, wrenches, given, sense, unloaded, accurate, disabled=None
     ) -> dict:
-        stacked = self.stacked(objective)
+        """One block: with osculating ellipsoids first where they apply, else (or where their
+        rounds do not settle) with cutting planes or no exact models at all."""
+        for osculating in (True, False) if self.osculating else (False,):
+            key = (objective, osculating)
+            stacked = self.stacked(*key)
+            self._set_parameters(key, stacked, wrenches, given, sense, unloaded, disabled)
+            exact = stacked.exact is not None  # rounds follow every solve
+            direct = None if accurate or exact else self._direct_result(key, stacked)
+            if direct is not None:
+                return direct
+            notes = []
+            status, settled = self._solve(key, stacked, self.solver, accurate, notes)
+            if osculating and not (settled and status == "optimal"):
+                continue
+            solver = self.solver
+            if status in ("solver-error", "inaccurate"):
+                fallback = _FALLBACK[solver]
+                notes.append(f"{solver} returned {status}; retried with {fallback}")
+                solver = fallback
+                status, _ = self._solve(key, stacked, solver, False, notes)
+            return self._result(stacked, status, solver, notes)
+
+    def _set_parameters(self, key, stacked, wrenches, given, sense, unloaded, disabled) -> None:
         assign(stacked.task, wrenches)
         scalars = tuple((i, float(v)) for i, v in given.items() if np.ndim(v) == 0)
-        if len(scalars) < len(given) or self._given.get(objective) != scalars:
+        if len(scalars) < len(given) or self._given.get(key) != scalars:
             set_given(stacked, given, wrenches.shape[1])  # (not again for the same forces)
-            self._given[objective] = scalars if len(scalars) == len(given) else None
+            self._given[key] = scalars if len(scalars) == len(given) else None
         if stacked.sense is not None:
             assign(stacked.sense, float(sense))
         if stacked.unloaded is not None:
             assign(stacked.unloaded, 0.0 if unloaded is None else unloaded.astype(float))
         if stacked.disabled is not None:
             assign(stacked.disabled, 0.0 if disabled is None else disabled.astype(float))
-        cuts = stacked.cuts is not None  # rounds of cuts follow every solve
-        direct = None if accurate or cuts else self._direct_result(objective, stacked)
-        if direct is not None:
-            return direct
-        notes = []
-        solver = self.solver
-        status = self._solve(objective, stacked, solver, accurate, notes)
-        if status in ("solver-error", "inaccurate"):
-            fallback = _FALLBACK[solver]
-            notes.append(f"{solver} returned {status}; retried with {fallback}")
-            solver = fallback
-            status = self._solve(objective, stacked, solver, False, notes)
+
+    @staticmethod
+    def _result(stacked: Stacked, status: str, solver: str, notes: list) -> dict:
         result = {"status": status, "solver": solver, "warnings": notes}
         if status in ("optimal", "inaccurate"):
             result.update(_values(stacked))
-            if stacked.cuts is not None:
-                result["known_use"] = stacked.cuts.use.copy()
+            if stacked.exact is not None:
+                result["known_use"] = stacked.exact.use.copy()
         if status in ("optimal", "inaccurate", "infeasible"):
             dual = stacked.balance.dual_value
             result["dual"] = None if dual is None else np.asarray(dual, dtype=float)
         return result
 
-    def _solve(self, objective, stacked: Stacked, solver: str, accurate: bool, notes) -> str:
-        """Solve ``stacked``, with rounds of cuts for its exact contacts (notes are appended);
-        each solve goes through Clarabel directly once a direct solver exists."""
+    def _solve(self, key, stacked: Stacked, solver: str, accurate: bool, notes) -> tuple:
+        """Solve ``stacked``, with the rounds of its exact contacts (notes are appended); each
+        solve goes through Clarabel directly once a direct solver exists. Returns the status
+        and whether the rounds settled (always, but for osculating ellipsoids)."""
 
         def once() -> str:
-            if not accurate and solver == self.solver and self._direct_into(objective, stacked):
+            if not accurate and solver == self.solver and self._direct_into(key, stacked):
                 return "optimal"
             status = _call(stacked.problem, solver, accurate=accurate)
             if status == "optimal" and solver == self.solver:
-                self._prepare_direct(objective, stacked)
+                self._prepare_direct(key, stacked)
             return status
 
         status = once()
-        if stacked.cuts is None:
-            return status
-        status, more = stacked.cuts.converge(once, status)
+        if stacked.exact is None:
+            return status, True
+        if isinstance(stacked.exact, OsculatingPool):
+            return stacked.exact.converge(once, status)
+        status, more = stacked.exact.converge(once, status)
         notes.extend(more)
-        return status
+        return status, True
 
-    def _direct_into(self, objective: str, stacked: Stacked) -> bool:
+    def _direct_into(self, key: tuple, stacked: Stacked) -> bool:
         """Solve through Clarabel directly into the cvxpy variables and the equilibrium's
         multipliers, where a direct solver exists and solves the problem."""
-        direct = self._direct.get(objective)
+        direct = self._direct.get(key)
         values = None if direct is None else direct.solve()
         dual = None if values is None else direct.dual(stacked.balance)
         if dual is None:
@@ -247,16 +274,16 @@ class Runner:
         stacked.balance.save_dual_value(dual)
         return True
 
-    def _direct_result(self, objective: str, stacked: Stacked) -> dict | None:
-        """Solve straight through Clarabel when a direct solver exists for ``objective``."""
-        if not self._direct_into(objective, stacked):
+    def _direct_result(self, key: tuple, stacked: Stacked) -> dict | None:
+        """Solve straight through Clarabel when a direct solver exists for ``key``."""
+        if not self._direct_into(key, stacked):
             return None
         dual = np.asarray(stacked.balance.dual_value, dtype=float)
-        solver = f"{self._direct[objective].method} (direct)"
+        solver = f"{self._direct[key].method} (direct)"
         return {"status": "optimal", "solver": solver, "warnings": [],
                 **_values(stacked), "dual": dual}  # fmt: skip
 
-    def _prepare_direct(self, objective: str, stacked: Stacked) -> None:
+    def _prepare_direct(self, key: tuple, stacked: Stacked) -> None:
         """Build the direct solver of an objective after its second cvxpy solve.
 
         It is checked against that solve's answer (same parameters); one-off problems never
@@ -264,15 +291,13 @@ class Runner:
         """
         if self.solver != "CLARABEL":
             return
-        if objective in self._direct or stacked.problem.status != cp.OPTIMAL:
+        if key in self._direct or stacked.problem.status != cp.OPTIMAL:
             return
         if not _uses_dpp(stacked.problem):
             return
-        self._solves[objective] = self._solves.get(objective, 0) + 1
-        if self._solves[objective] >= 2:
-            self._direct[objective] = DirectSolver.create(
-                stacked.problem, _SOLVER_OPTIONS["CLARABEL"]
-            )
+        self._solves[key] = self._solves.get(key, 0) + 1
+        if self._solves[key] >= 2:
+            self._direct[key] = DirectSolver.create(stacked.problem, _SOLVER_OPTIONS["CLARABEL"])
 
 
 #: Up to this many cases are ordered by nearest neighbours (quadratic time); more by angle.

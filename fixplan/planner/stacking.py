@@ -25,8 +25,10 @@ import scipy.sparse as sp
 
 from fixplan.models.base import FrictionModel
 from fixplan.models.conic import ConicForm, soc_columns
+from fixplan.models.exact import Exact
 from fixplan.planner.cuts import CutPool
 from fixplan.planner.objectives import objective_expression
+from fixplan.planner.osculating import OsculatingPool
 from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, PASSIVE_ROLES, Problem
 from fixplan.tolerances import MAX_SAFETY_FACTOR
 
@@ -56,6 +58,9 @@ class ContactLayout:
         frictionless contact), so the planner states it.
     models : tuple of FrictionModel
         The friction model of each contact (exact models get cuts, :mod:`fixplan.planner.cuts`).
+    osculating : bool
+        The exact contacts' sets are left out of ``cones``: osculating ellipsoids state them
+        (:mod:`fixplan.planner.osculating`).
     """
 
     normal_map: np.ndarray
@@ -65,15 +70,21 @@ class ContactLayout:
     aux_size: int
     signed: np.ndarray
     models: tuple[FrictionModel, ...]
+    osculating: bool = False
 
     @classmethod
-    def of(cls, problem: Problem, models: list[FrictionModel]) -> ContactLayout:
-        """The layout of ``problem``'s contacts with their friction ``models``."""
+    def of(
+        cls, problem: Problem, models: list[FrictionModel], *, osculating: bool = False
+    ) -> ContactLayout:
+        """The layout of ``problem``'s contacts with their friction ``models`` (``osculating``:
+        see the attribute)."""
         dims = [model.load_dimension for model in models]
         bases = [contact.wrench_basis() for contact in problem.contacts]
         starts = np.concatenate([[0], np.cumsum(dims)])
         slices = tuple(slice(int(a), int(b)) for a, b in itertools.pairwise(starts))
-        forms = [model.conic_form() for model in models]
+        forms = [
+            _NO_ROWS if osculating and _exact(model) else model.conic_form() for model in models
+        ]
         aux_starts = np.concatenate([[0], np.cumsum([f.aux.shape[1] for f in forms])])
         return cls(
             normal_map=np.column_stack([basis[:, 0] for basis in bases]),
@@ -85,7 +96,16 @@ class ContactLayout:
             aux_size=int(aux_starts[-1]),
             signed=np.array([not form.bounds_normal for form in forms]),
             models=tuple(models),
+            osculating=osculating,
         )
+
+
+#: The form of a contact whose set is stated elsewhere (an osculating ellipsoid).
+_NO_ROWS = ConicForm(normal=np.zeros(0), load=np.zeros((0, 3)), aux=np.zeros((0, 0)), cones=())
+
+
+def _exact(model: FrictionModel) -> bool:
+    return isinstance(model, Exact) and not model.frictionless
 
 
 def _stack_cones(forms: list[ConicForm], starts, aux_starts) -> dict:
@@ -150,8 +170,9 @@ class Stacked:
     decided : numpy.ndarray
         ``(C,)`` bool: the contact's normal force is a decision variable (passive, or an active
         contact whose force is free in this objective).
-    cuts : CutPool or None
-        The tangent-plane cuts of the exact contacts (``None`` without exact models).
+    exact : CutPool or OsculatingPool or None
+        The rounds that bring the exact contacts' loads inside their sets: tangent-plane cuts,
+        or osculating ellipsoids in an ``osculating`` layout (``None`` without exact models).
     disabled : cvxpy.Parameter or None
         ``(C,)``: 1 where a contact is switched off (its normal force held at 0, so its friction
         load too), for layouts that use some of the contacts (``switchable`` in :func:`build`).
@@ -171,7 +192,7 @@ class Stacked:
     scale: cp.Expression
     balance: cp.Constraint
     decided: np.ndarray
-    cuts: CutPool | None
+    exact: CutPool | OsculatingPool | None
     disabled: cp.Parameter | None = None
 
 
@@ -268,10 +289,11 @@ def build(
             limits = np.asarray(limits)
             variable = pieces[key][list(rows)]
             constraints.append(variable <= (limits[:, None] if key == "finger" else limits))
-    cuts = CutPool.of(layout.models, layout.slices, normal, friction,
-                      wrenches=layout.friction_map, balance=balance)  # fmt: skip
-    if cuts is not None:
-        constraints.append(cuts.constraint)
+    pool = OsculatingPool if layout.osculating else CutPool
+    exact = pool.of(layout.models, layout.slices, normal, friction,
+                    wrenches=layout.friction_map, balance=balance)  # fmt: skip
+    if exact is not None:
+        constraints += exact.constraints
     unloaded = None
     if squeeze and groups["passive"]:
         unloaded = cp.Parameter((len(groups["passive"]), cases), nonneg=True, name="unloaded")
@@ -318,7 +340,7 @@ def build(
         scale=scale,
         balance=balance,
         decided=decided,
-        cuts=cuts,
+        exact=exact,
         disabled=disabled,
     )
 

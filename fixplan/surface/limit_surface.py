@@ -218,6 +218,20 @@ class LimitSurface:
         values = self._scale * self._kernel.support(twists)
         return float(values[0]) if single else values
 
+    def support_hessian(self, twist) -> np.ndarray:
+        """Hessian ``∇²h`` ``(3, 3)`` or ``(K, 3, 3)`` of the support function at nonzero twists:
+        the derivative of :meth:`load` (analytic for disks, polygons and grids)."""
+        twists, single, zero = _vectors("twist", twist)
+        if zero is not None:
+            raise InvalidArgumentError(f"twist[{zero}] is zero: the support has no Hessian there")
+        hessians = self._scale * self._kernel.hessian(twists)
+        return hessians[0] if single else hessians
+
+    @property
+    def has_facets(self) -> bool:
+        """Whether the surface has facets: discrete point supports, where ``h`` has kinks."""
+        return len(self._kernel.facets[0]) > 0
+
     def load(self, twist) -> np.ndarray:
         """Load ``(fx, fy, m)`` on the surface that sustains sliding with ``twist``.
 

@@ -1,0 +1,220 @@
+r"""Exact friction models in the planner: osculating ellipsoids, moved until they agree.
+
+A smooth exact set (a patch without point supports) is replaced, per (contact, load case), by
+an ellipsoid ``‖R_ij ℓ_ij‖ <= n_ij`` with Parameters ``R`` (so the problem is compiled once),
+first the ellipsoid through the set's axis points, then after every solve the ellipsoid that
+osculates the exact set where the ray of the solved load meets it
+(:meth:`~fixplan.models.Exact.osculating`: same point, tangent plane and curvature). This is
+sequential convex programming with exact second-order models: near the optimum each round
+squares the distance to it, where tangent planes alone (:mod:`fixplan.planner.cuts`) gain a
+constant factor per round. Each round is a conic problem of the size of the ellipsoid model's.
+
+The ellipsoids are not outer approximations, so a round is not a relaxation: the rounds stop
+when the solve meets the optimality conditions of the exact problem. Every contact load lies
+inside its exact set (to ``EXACT_CUT_RTOL``), and each contact's twist in the impending motion
+(the equilibrium's multipliers mapped to the contact, ``V_ij = -G_iᵀ y_j``, zero where the
+contact does not limit the optimum) is normal to the exact set at its load (``STATIONARITY_RTOL``)
+with the load on the exact surface (``COMPLEMENTARITY_RTOL``), each weighed by the twist's size
+relative to the largest. Loads of contacts that do not limit the optimum may be anywhere inside
+(an optimum's loads are often not unique). Rounds that do not get there (``MAX_ROUNDS``), or a
+solve that is not optimal (an ellipsoid can cut off a feasible load), leave the problem to the
+cutting planes, whose relaxations also certify infeasibility.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import cvxpy as cp
+import numpy as np
+import scipy.sparse as sp
+
+from fixplan.models.exact import Exact
+from fixplan.tolerances import EXACT_CUT_RTOL, FRICTION_SET_RTOL
+
+#: Most solves of one problem; a problem not settled by then goes to the cutting planes.
+MAX_ROUNDS = 12
+
+#: Largest distance between the unit directions (normalised coordinates) of a contact's twist
+#: in the impending motion and of the exact set's normal at its load, times the twist's size
+#: relative to the largest.
+STATIONARITY_RTOL = 1e-6
+
+#: Largest relative gap ``1 - 1/s`` of a load inside its exact set, times the size of its
+#: contact's twist relative to the largest (the ellipsoids' ``MARGIN`` leaves 1e-8).
+COMPLEMENTARITY_RTOL = 1e-7
+
+#: Tangent-plane cuts per (contact, load case) besides the ellipsoid. A contact that does not
+#: limit the optimum can take any load of a face of optima, which an ellipsoid that is not
+#: outer may leave outside the exact set; its cut (the tangent plane at that load's ray, valid
+#: for the exact set) keeps the next solve from it. New cuts replace the oldest.
+CUT_SLOTS = 2
+
+#: Ellipsoids are tightened by this fraction (``(1 + MARGIN) ‖R ℓ‖ <= n``), so that the solver's
+#: feasibility error (about 1e-9) does not leave a load outside by more than ``EXACT_CUT_RTOL``.
+MARGIN = 1e-8
+
+
+def smooth(models) -> bool:
+    """Whether every exact model among ``models`` has a smooth set (no facets), so that the
+    osculating ellipsoids apply; ``False`` without exact models."""
+    exact = [m for m in models if isinstance(m, Exact) and not m.frictionless]
+    return bool(exact) and not any(m.surface.has_facets for m in exact)
+
+
+class OsculatingPool:
+    """The ellipsoid Parameters of a stacked problem's exact contacts, and their rounds.
+
+    Parameters
+    ----------
+    models : dict
+        Contact index -> its smooth :class:`~fixplan.models.Exact` model.
+    slices : tuple of slice
+        Rows of each contact's friction load in the stacked friction variable.
+    normal : cvxpy.Expression
+        ``(C, K)`` normal forces [N].
+    friction : cvxpy.Variable
+        ``(D, K)`` friction loads.
+    wrenches : numpy.ndarray
+        ``(6, D)`` body wrench per unit friction load component (the equilibrium's ``G``).
+    balance : cvxpy.Constraint
+        The equilibrium; its multipliers ``(6, K)`` are the impending motion of each case.
+    """
+
+    def __init__(
+        self,
+        models: dict,
+        slices,
+        normal: cp.Expression,
+        friction: cp.Variable,
+        *,
+        wrenches: np.ndarray,
+        balance: cp.Constraint,
+    ):
+        self._contacts = np.array(sorted(models), dtype=int)
+        self._models = [models[i] for i in self._contacts]
+        self._rows = np.array([np.arange(slices[i].start, slices[i].stop) for i in self._contacts])
+        self._normal, self._friction, self._balance = normal, friction, balance
+        self._wrenches = np.array([wrenches[:, rows] for rows in self._rows])  # (E, 6, 3)
+        self._units = np.array([model._units() for model in self._models])  # (E, 3)
+        count, cases = len(self._contacts), friction.shape[1]
+        self._factors = np.zeros((count, cases, 3, 3))
+        self._factors[:, :, [0, 1, 2], [0, 1, 2]] = (1.0 + MARGIN) / self._units[:, None, :]
+        self._planes = np.zeros((3, CUT_SLOTS, count, cases))
+        self._next_slot = np.zeros((count, cases), dtype=int)
+        #: ``(C, K)`` friction use ``1 / s`` of every exact contact's load in the last solve the
+        #: rounds checked (NaN for other contacts and unpressed ones).
+        self.use = np.full((normal.shape[0], cases), np.nan)
+        self._entries = [(r, c) for r in range(3) for c in range(r, 3)]  # upper triangle
+        self._parameters = [
+            cp.Parameter((count, cases), name=f"osculating_{r}{c}") for r, c in self._entries
+        ]
+        loads = [friction[self._rows[:, c], :] for c in range(3)]
+        rows = [0, 0, 0]
+        for (r, c), parameter in zip(self._entries, self._parameters, strict=True):
+            rows[r] = rows[r] + cp.multiply(parameter, loads[c])
+        stacked = cp.vstack([cp.vec(row, order="F") for row in rows])
+        forces = normal[self._contacts, :]
+        self._cut_parameters = [
+            cp.Parameter((CUT_SLOTS * count, cases), name=f"osculating_cut_{c}") for c in range(3)
+        ]
+        tile = sp.vstack([sp.eye_array(count)] * CUT_SLOTS, format="csr")
+        cut_rows = sum(
+            cp.multiply(parameter, tile @ loads[c])
+            for c, parameter in enumerate(self._cut_parameters)
+        )
+        self.constraints = [
+            cp.SOC(cp.vec(forces, order="F"), stacked, axis=0),
+            cut_rows <= tile @ forces,
+        ]
+        self._assign()
+
+    @classmethod
+    def of(cls, models, slices, normal, friction, *, wrenches, balance) -> OsculatingPool | None:
+        """The pool of the exact models among ``models`` (one per contact), or ``None``."""
+        exact = {i: m for i, m in enumerate(models) if isinstance(m, Exact) and not m.frictionless}
+        if not exact:
+            return None
+        return cls(exact, slices, normal, friction, wrenches=wrenches, balance=balance)
+
+    def converge(self, solve: Callable[[], str], status: str) -> tuple[str, bool]:
+        """Move the ellipsoids and re-solve (``solve()`` returns the status) from a first
+        solve's ``status``; the final status and whether the rounds settled on the exact
+        optimum (otherwise the cutting planes take over)."""
+        for _ in range(MAX_ROUNDS):
+            if status not in ("optimal", "inaccurate"):
+                return status, False
+            if self.move():
+                return status, True
+            status = solve()
+        return status, False
+
+    def move(self) -> bool:
+        """Put each ellipsoid where its contact's solved load meets the exact set; whether the
+        solve already met the exact problem's optimality conditions (see the module)."""
+        normal = np.asarray(self._normal.value, dtype=float)
+        friction = np.asarray(self._friction.value, dtype=float)
+        forces = normal[self._contacts]  # (E, K)
+        loads = np.moveaxis(friction[self._rows], 1, 0)  # (3, E, K)
+        twists = self._twists()  # (E, K, 3), normalised
+        sizes = np.linalg.norm(twists, axis=2)
+        weights = sizes / max(float(sizes.max(initial=0.0)), 1e-300)
+        noise = FRICTION_SET_RTOL * max(float(np.abs(normal).max(initial=0.0)), 1e-300)
+        settled = True
+        self.use[:] = np.nan
+        for e, model in enumerate(self._models):
+            cases = np.flatnonzero(forces[e] > noise)
+            per_unit = loads[:, e, cases].T / forces[e, cases, None]
+            moving = np.abs(per_unit).max(axis=1, initial=0.0) > 0.0
+            cases, per_unit = cases[moving], per_unit[moving]
+            if cases.size == 0:
+                continue
+            excess, points, factors = model.osculating(per_unit)
+            self.use[self._contacts[e], cases] = 1.0 + excess
+            used = self._factors[e, cases]
+            exact_normals = _normals(factors, points)
+            weight = weights[e, cases]
+            gap = weight * _chord(_normals(used, per_unit), exact_normals)
+            settled &= bool(np.all(excess <= EXACT_CUT_RTOL))
+            settled &= bool(np.all(gap <= STATIONARITY_RTOL))
+            settled &= bool(np.all(weight * np.maximum(-excess, 0.0) <= COMPLEMENTARITY_RTOL))
+            usable = np.all(np.isfinite(factors), axis=(1, 2))
+            self._factors[e, cases[usable]] = factors[usable] * (1.0 + MARGIN)
+            outside = np.flatnonzero(usable & (excess > EXACT_CUT_RTOL))
+            if outside.size:
+                planes = (
+                    exact_normals[outside]
+                    / np.einsum("kc,kc->k", exact_normals[outside], points[outside])[:, None]
+                )
+                slots = self._next_slot[e, cases[outside]]
+                self._planes[:, slots, e, cases[outside]] = planes.T * (1.0 + MARGIN)
+                self._next_slot[e, cases[outside]] = (slots + 1) % CUT_SLOTS
+        self._assign()
+        return settled
+
+    def _twists(self) -> np.ndarray:
+        """``(E, K, 3)`` normalised twists ``(vx, vy, w) * units`` of the exact contacts in the
+        last solve's impending motion, ``-G_iᵀ y``."""
+        dual = np.asarray(self._balance.dual_value, dtype=float)
+        twists = -np.einsum("exr,xk->ekr", self._wrenches, dual)
+        return twists * self._units[:, None, :]
+
+    def _assign(self) -> None:
+        for (r, c), parameter in zip(self._entries, self._parameters, strict=True):
+            parameter.value = self._factors[:, :, r, c]
+        shape = self._cut_parameters[0].shape
+        for c, parameter in enumerate(self._cut_parameters):
+            parameter.value = self._planes[c].reshape(shape)
+
+
+def _normals(factors: np.ndarray, loads: np.ndarray) -> np.ndarray:
+    """Outward normals ``RᵀR q`` ``(K, 3)`` of the ellipsoids ``‖R q‖ <= 1`` at the loads'
+    rays (twists, up to their sizes)."""
+    return np.einsum("krc,krd,kd->kc", factors, factors, loads)
+
+
+def _chord(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """Distance between the unit directions of the rows of ``first`` and ``second`` ``(K, 3)``
+    (NaN where one is not finite)."""
+    first = first / np.linalg.norm(first, axis=1, keepdims=True)
+    return np.linalg.norm(first - second / np.linalg.norm(second, axis=1, keepdims=True), axis=1)
