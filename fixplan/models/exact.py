@@ -33,6 +33,7 @@ import numpy as np
 from fixplan.models.base import FrictionModel, fmt
 from fixplan.models.conic import unit_conic
 from fixplan.models.ellipsoid import surface_units
+from fixplan.surface.point_kernel import compiled_scalar
 from fixplan.surface.sphere import fibonacci_sphere
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -170,14 +171,9 @@ class Exact(FrictionModel):
         a, u = planes * units, points / units  # normalised plane and point, a · u = 1
         curvature = self.surface.support_hessian(planes) / self.surface.normal_force
         curvature /= units[None, :, None] * units[None, None, :]
-        axis = a / np.linalg.norm(a, axis=1, keepdims=True)
-        along = axis[:, :, None] * axis[:, None, :]
-        inverse = np.linalg.inv(curvature + along) - along  # J⁺: J has the null vector a
-        away = np.eye(3) - a[:, :, None] * u[:, None, :]
-        shape = away @ inverse @ away.transpose(0, 2, 1) + a[:, :, None] * a[:, None, :]
-        with np.errstate(invalid="ignore"):
-            factors = np.linalg.cholesky(0.5 * (shape + shape.transpose(0, 2, 1)))
-        return excess, points, factors.transpose(0, 2, 1) / units[None, None, :]
+        factors = np.empty((len(loads), 3, 3))
+        _OSCULATING_FACTORS(a, u, curvature, factors)
+        return excess, points, factors / units[None, None, :]
 
     def _cut_terms(self, loads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Excess ``1 / s - 1`` and tangent planes ``V / h_1(V)`` of loads ``(K, 3)``."""
@@ -212,3 +208,57 @@ class Exact(FrictionModel):
             f"Exact({self.surface!r}, mu={fmt(self.mu)}, rho={fmt(self.rho)} m, "
             f"normal_force={fmt(self.normal_force)} N)"
         )
+
+
+def osculating_factors(planes, points, curvatures, out):  # pragma: no cover - compiled
+    """Upper triangular ``out[k]`` ``(3, 3)`` with ``RᵀR = (I - a uᵀ) J⁺ (I - u aᵀ) + a aᵀ`` for
+    each normalised plane ``a``, point ``u`` and support Hessian ``J`` (``J a = 0``), from
+    ``J⁺ = (J + â âᵀ)⁻¹ - â âᵀ``; NaN where that matrix is not positive definite."""
+    for k in range(planes.shape[0]):
+        a = planes[k]
+        u = points[k]
+        size = np.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+        m = np.empty((3, 3))
+        for i in range(3):
+            for j in range(3):
+                m[i, j] = curvatures[k, i, j] + a[i] * a[j] / (size * size)
+        cof = np.empty((3, 3))
+        cof[0, 0] = m[1, 1] * m[2, 2] - m[1, 2] * m[2, 1]
+        cof[0, 1] = m[0, 2] * m[2, 1] - m[0, 1] * m[2, 2]
+        cof[0, 2] = m[0, 1] * m[1, 2] - m[0, 2] * m[1, 1]
+        cof[1, 0] = m[1, 2] * m[2, 0] - m[1, 0] * m[2, 2]
+        cof[1, 1] = m[0, 0] * m[2, 2] - m[0, 2] * m[2, 0]
+        cof[1, 2] = m[0, 2] * m[1, 0] - m[0, 0] * m[1, 2]
+        cof[2, 0] = m[1, 0] * m[2, 1] - m[1, 1] * m[2, 0]
+        cof[2, 1] = m[0, 1] * m[2, 0] - m[0, 0] * m[2, 1]
+        cof[2, 2] = m[0, 0] * m[1, 1] - m[0, 1] * m[1, 0]
+        det = m[0, 0] * cof[0, 0] + m[0, 1] * cof[1, 0] + m[0, 2] * cof[2, 0]
+        pinv = np.empty((3, 3))
+        for i in range(3):
+            for j in range(3):
+                pinv[i, j] = cof[i, j] / det - a[i] * a[j] / (size * size)
+        away = np.empty((3, 3))  # I - a uᵀ
+        for i in range(3):
+            for j in range(3):
+                away[i, j] = (1.0 if i == j else 0.0) - a[i] * u[j]
+        shape = np.empty((3, 3))
+        for i in range(3):
+            for j in range(3):
+                total = a[i] * a[j]
+                for p in range(3):
+                    for q in range(3):
+                        total += away[i, p] * pinv[p, q] * away[j, q]
+                shape[i, j] = total
+        r = out[k]
+        r[:] = 0.0
+        r[0, 0] = np.sqrt(shape[0, 0]) if shape[0, 0] > 0.0 else np.nan
+        r[0, 1] = 0.5 * (shape[0, 1] + shape[1, 0]) / r[0, 0]
+        r[0, 2] = 0.5 * (shape[0, 2] + shape[2, 0]) / r[0, 0]
+        rest = shape[1, 1] - r[0, 1] * r[0, 1]
+        r[1, 1] = np.sqrt(rest) if rest > 0.0 else np.nan
+        r[1, 2] = (0.5 * (shape[1, 2] + shape[2, 1]) - r[0, 1] * r[0, 2]) / r[1, 1]
+        rest = shape[2, 2] - r[0, 2] * r[0, 2] - r[1, 2] * r[1, 2]
+        r[2, 2] = np.sqrt(rest) if rest > 0.0 else np.nan
+
+
+_OSCULATING_FACTORS = compiled_scalar(osculating_factors)

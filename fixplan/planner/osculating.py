@@ -160,35 +160,39 @@ class OsculatingPool:
         sizes = np.linalg.norm(twists, axis=2)
         weights = sizes / max(float(sizes.max(initial=0.0)), 1e-300)
         noise = FRICTION_SET_RTOL * max(float(np.abs(normal).max(initial=0.0)), 1e-300)
-        settled = True
+        pressed = forces > noise
+        per_unit = np.where(pressed, loads, 0.0) / np.where(pressed, forces, 1.0)  # (3, E, K)
+        moving = pressed & (np.abs(per_unit).max(axis=0) > 0.0)
         self.use[:] = np.nan
-        for e, model in enumerate(self._models):
-            cases = np.flatnonzero(forces[e] > noise)
-            per_unit = loads[:, e, cases].T / forces[e, cases, None]
-            moving = np.abs(per_unit).max(axis=1, initial=0.0) > 0.0
-            cases, per_unit = cases[moving], per_unit[moving]
-            if cases.size == 0:
-                continue
-            excess, points, factors = model.osculating(per_unit)
-            self.use[self._contacts[e], cases] = 1.0 + excess
-            used = self._factors[e, cases]
-            exact_normals = _normals(factors, points)
-            weight = weights[e, cases]
-            gap = weight * _chord(_normals(used, per_unit), exact_normals)
-            settled &= bool(np.all(excess <= EXACT_CUT_RTOL))
-            settled &= bool(np.all(gap <= STATIONARITY_RTOL))
-            settled &= bool(np.all(weight * np.maximum(-excess, 0.0) <= COMPLEMENTARITY_RTOL))
-            usable = np.all(np.isfinite(factors), axis=(1, 2))
-            self._factors[e, cases[usable]] = factors[usable] * (1.0 + MARGIN)
-            outside = np.flatnonzero(usable & (excess > EXACT_CUT_RTOL))
-            if outside.size:
-                planes = (
-                    exact_normals[outside]
-                    / np.einsum("kc,kc->k", exact_normals[outside], points[outside])[:, None]
-                )
-                slots = self._next_slot[e, cases[outside]]
-                self._planes[:, slots, e, cases[outside]] = planes.T * (1.0 + MARGIN)
-                self._next_slot[e, cases[outside]] = (slots + 1) % CUT_SLOTS
+        if not moving.any():
+            return True
+        found = [
+            model.osculating(per_unit[:, e, moving[e]].T)
+            for e, model in enumerate(self._models)
+            if moving[e].any()
+        ]
+        owner, cases = np.nonzero(moving)  # contact by contact, as found
+        excess, points, factors = (np.concatenate(part) for part in zip(*found, strict=True))
+        per_unit = per_unit[:, owner, cases].T
+        self.use[self._contacts[owner], cases] = 1.0 + excess
+        exact_normals = _normals(factors, points)
+        used = _normals(self._factors[owner, cases], per_unit)
+        weight = weights[owner, cases]
+        settled = bool(
+            np.all(excess <= EXACT_CUT_RTOL)
+            and np.all(weight * _chord(used, exact_normals) <= STATIONARITY_RTOL)
+            and np.all(weight * np.maximum(-excess, 0.0) <= COMPLEMENTARITY_RTOL)
+        )
+        usable = np.all(np.isfinite(factors), axis=(1, 2))
+        self._factors[owner[usable], cases[usable]] = factors[usable] * (1.0 + MARGIN)
+        outside = np.flatnonzero(usable & (excess > EXACT_CUT_RTOL))
+        if outside.size:
+            e, k = owner[outside], cases[outside]
+            normals = exact_normals[outside]
+            planes = normals / np.einsum("kc,kc->k", normals, points[outside])[:, None]
+            slots = self._next_slot[e, k]
+            self._planes[:, slots, e, k] = planes.T * (1.0 + MARGIN)
+            self._next_slot[e, k] = (slots + 1) % CUT_SLOTS
         self._assign()
         return settled
 

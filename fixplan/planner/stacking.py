@@ -82,8 +82,10 @@ class ContactLayout:
         bases = [contact.wrench_basis() for contact in problem.contacts]
         starts = np.concatenate([[0], np.cumsum(dims)])
         slices = tuple(slice(int(a), int(b)) for a, b in itertools.pairwise(starts))
+        elsewhere = [osculating and _exact(model) for model in models]  # an ellipsoid bounds N
         forms = [
-            _NO_ROWS if osculating and _exact(model) else model.conic_form() for model in models
+            _NO_ROWS if e else model.conic_form()
+            for e, model in zip(elsewhere, models, strict=True)
         ]
         aux_starts = np.concatenate([[0], np.cumsum([f.aux.shape[1] for f in forms])])
         return cls(
@@ -94,7 +96,9 @@ class ContactLayout:
             slices=slices,
             cones=_stack_cones(forms, starts, aux_starts),
             aux_size=int(aux_starts[-1]),
-            signed=np.array([not form.bounds_normal for form in forms]),
+            signed=np.array(
+                [not (e or form.bounds_normal) for e, form in zip(elsewhere, forms, strict=True)]
+            ),
             models=tuple(models),
             osculating=osculating,
         )

@@ -464,8 +464,18 @@ def _solve(
         out_safety[k] = safety / size
 
 
+def _hessians(kernel, twists, out):  # pragma: no cover - compiled
+    """Support Hessians ``out`` ``(K, 3, 3)`` of the unit-friction ``kernel`` at ``twists``."""
+    local = np.empty(10)
+    terms = np.empty(10)
+    for k in range(twists.shape[0]):
+        _terms(kernel, 0.0, twists[k], True, local, terms)
+        _unpack(terms, out[k])
+
+
 _terms = compiled_scalar(_terms)
 _unpack = compiled_scalar(_unpack)
+_hessians = compiled_scalar(_hessians)
 _projected = compiled_scalar(_projected)
 _newton_step = compiled_scalar(_newton_step)
 _newton = compiled_scalar(_newton)
@@ -514,6 +524,12 @@ class CompiledKernel:
         if gradient[worst] > INVERSE_GRADIENT_RTOL:
             raise not_converged(loads[worst], float(gradient[worst]))
         return safety, twist
+
+    def hessians(self, twists: np.ndarray) -> np.ndarray:
+        """Hessians ``(K, 3, 3)`` of the unit-friction support at nonzero ``twists`` ``(K, 3)``."""
+        out = np.empty((len(twists), 3, 3))
+        _hessians(self.parts, np.ascontiguousarray(twists, dtype=float), out)
+        return out
 
 
 def not_converged(load: np.ndarray, relative_gradient: float) -> ConvergenceError:

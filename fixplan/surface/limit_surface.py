@@ -224,7 +224,10 @@ class LimitSurface:
         twists, single, zero = _vectors("twist", twist)
         if zero is not None:
             raise InvalidArgumentError(f"twist[{zero}] is zero: the support has no Hessian there")
-        hessians = self._scale * self._kernel.hessian(twists)
+        if self._compiled is not None:
+            hessians = self._scale * self._compiled.hessians(twists)
+        else:
+            hessians = self._scale * self._kernel.hessian(twists)
         return hessians[0] if single else hessians
 
     @property
