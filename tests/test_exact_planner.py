@@ -17,6 +17,7 @@ every plan lies inside its exact surface to 1e-9 (``EXACT_CUT_RTOL``).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -232,26 +233,58 @@ def milling_fixture(model: str, seed: int) -> Problem:
                    loads=loads, objective="min-total-clamp-force")  # fmt: skip
 
 
-@pytest.mark.parametrize("seed", [0, 1, 2])
-def test_osculating_ellipsoids_find_the_optimum_of_the_cutting_planes(seed, monkeypatch):
-    """The two ways of stating exact models agree: the cutting planes (relaxations, exact when
-    every load is inside) and the osculating ellipsoids (stopped by the optimality conditions),
-    on a fixture of disk and rectangle patches, first solve and re-solve with new loads."""
-    problem = milling_fixture("exact", seed)
+def solved_both_ways(problem: Problem, loads, monkeypatch) -> tuple[list, list]:
+    """Plans of ``problem`` and a re-solve with ``loads``: with osculating ellipsoids (checked
+    to have settled without the cutting planes) and with cutting planes alone."""
     osculating = Planner(problem)
-    first = osculating.solve()
-    again = osculating.solve(milling_fixture("exact", seed + 10).loads)
+    found = [osculating.solve(), osculating.solve(loads)]
     assert osculating._runner.osculating
     assert (problem.objective, False) not in osculating._runner._built  # no fallback
-    monkeypatch.setattr(runner, "smooth", lambda models: False)
-    cutting = Planner(problem)
-    assert not cutting._runner.osculating
-    expected = [cutting.solve(), cutting.solve(milling_fixture("exact", seed + 10).loads)]
-    for plan, reference in zip([first, again], expected, strict=True):
+    with monkeypatch.context() as patch:
+        patch.setattr(runner, "smooth", lambda models: False)
+        cutting = Planner(problem)
+        assert not cutting._runner.osculating
+        expected = [cutting.solve(), cutting.solve(loads)]
+    for plan, reference in zip(found, expected, strict=True):
         assert plan.status == reference.status == "optimal"
-        assert plan.objective_value == pytest.approx(reference.objective_value, rel=OPTIMUM_RTOL)
-        assert plan.safety_factor == pytest.approx(reference.safety_factor, rel=1e-6)
         assert_loads_inside_their_exact_surfaces(problem, plan)
+    return found, expected
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_osculating_ellipsoids_find_the_least_clamp_force_of_the_cutting_planes(seed, monkeypatch):
+    """The two ways of stating exact models agree: the cutting planes (relaxations, exact when
+    every load is inside) and the osculating ellipsoids (stopped by the optimality conditions),
+    on a fixture of disk and rectangle patches, first solve and re-solve with new loads. (The
+    split of the least total between the two clamps need not be unique, so the safety factors of
+    the forces found are compared with 1: the contacts pressed below ``FRICTION_SET_RTOL`` of
+    the largest force are not held to their exact sets, which leaves them up to 1e-5 short.)"""
+    problem = milling_fixture("exact", seed)
+    found, expected = solved_both_ways(problem, milling_fixture("exact", seed + 10).loads,
+                                       monkeypatch)  # fmt: skip
+    for plan, reference in zip(found, expected, strict=True):
+        assert plan.objective_value == pytest.approx(reference.objective_value, rel=OPTIMUM_RTOL)
+        assert plan.safety_factor == pytest.approx(1.0, abs=1e-5)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_osculating_ellipsoids_find_the_held_intervals_of_the_cutting_planes(seed, monkeypatch):
+    """Given clamp forces: every load case's held interval (both ends, six cases in blocks)
+    agrees between the two ways within 5e-7: both end in interior-point solves, which leave the
+    limiting loads a few 1e-7 inside their exact surfaces (here the cutting planes' 14.4941062
+    against 14.4941085, whose loads are all inside too, so the exact optimum is at least that)."""
+    problem = milling_fixture("exact", seed)
+    contacts = [
+        dataclasses.replace(c, force=80.0 + 40.0 * k) if c.role == "clamp" else c
+        for k, c in enumerate(problem.contacts)
+    ]
+    problem = dataclasses.replace(problem, contacts=contacts, objective="max-safety-factor")
+    found, expected = solved_both_ways(problem, milling_fixture("exact", seed + 10).loads,
+                                       monkeypatch)  # fmt: skip
+    for plan, reference in zip(found, expected, strict=True):
+        for name, (low, high) in reference.held_intervals.items():
+            assert plan.held_intervals[name][0] == pytest.approx(low, rel=5e-7, abs=1e-7)
+            assert plan.held_intervals[name][1] == pytest.approx(high, rel=5e-7)
 
 
 def test_rounds_that_do_not_settle_leave_the_problem_to_the_cutting_planes(monkeypatch):

@@ -226,13 +226,16 @@ class Planner:
         accurate=False,
         progress=None,
         disabled=None,
+        cases=None,
     ):
         """Solve ``objective``, unloading passive contacts until no case holds a squeeze.
 
         ``squeezed`` collects, per load case name, the contacts unloaded (for the notes);
-        ``disabled`` ``(C,)`` bool marks the contacts switched off.
+        ``disabled`` ``(C,)`` bool marks the contacts switched off; ``cases`` numbers the load
+        cases of ``wrenches`` among the problem's (default: all, in order).
         """
-        options = {"sense": sense, "accurate": accurate, "progress": progress, "disabled": disabled}
+        options = {"sense": sense, "accurate": accurate, "progress": progress,
+                   "disabled": disabled, "cases": cases}  # fmt: skip
         result = self._runner.run(objective, wrenches, given, **options)
         if not self.squeeze_contacts:
             return result
@@ -294,7 +297,7 @@ class Planner:
             values = {i: v if np.ndim(v) == 0 else np.asarray(v)[index] for i, v in given.items()}
             return self._squeeze_free(
                 "check", wrenches[:, index], values, squeezed, sense=-1.0, progress=report,
-                disabled=disabled,
+                disabled=disabled, cases=index,
             )  # fmt: skip
 
         cases = wrenches.shape[1]

@@ -107,6 +107,9 @@ class Runner:
         #: where those rounds do not settle.
         self.osculating = solver == "CLARABEL" and smooth(layout.models)
         self._layouts = {False: layout}
+        # The last ellipsoids (E, 3, 3) of each load case, whichever program placed them: the
+        # next program that solves the case starts from them.
+        self._ellipsoids: dict[int, np.ndarray] = {}
         if self.osculating:
             self._layouts[True] = ContactLayout.of(problem, list(layout.models), osculating=True)
         #: Whether the fixed-force programs are linear (pyramid models): their cases are then
@@ -144,6 +147,7 @@ class Runner:
         accurate: bool = False,
         progress=None,
         disabled: np.ndarray | None = None,
+        cases: np.ndarray | None = None,
     ) -> dict:
         """Solve all load cases (task ``wrenches`` ``(6, K)``), block by block.
 
@@ -152,13 +156,15 @@ class Runner:
         ``unloaded`` ``(passive, K)`` marks passive contacts held without normal force;
         ``accurate`` turns Clarabel's iterative refinement on (for a retry when an answer failed
         verification); ``disabled`` ``(C,)`` bool switches contacts off (a runner built
-        ``switchable``). The last block is padded with copies of its first case.
+        ``switchable``); ``cases`` ``(K,)`` numbers the load cases among the problem's (default
+        ``0 ... K-1``). The last block is padded with copies of its first case.
         """
+        numbers = np.arange(wrenches.shape[1]) if cases is None else np.asarray(cases)
         cases = wrenches.shape[1]
         block = self.block_size(objective)
         if cases == block:  # one block, no padding (re-solves in a control loop)
             result = self._run_block(
-                objective, wrenches, given, sense, unloaded, accurate, disabled
+                objective, wrenches, given, sense, unloaded, accurate, disabled, numbers
             )
             if progress is not None:
                 progress(cases, cases)
@@ -176,8 +182,9 @@ class Runner:
             }
             mask = None if unloaded is None else unloaded[:, padded]
             result = self._run_block(
-                objective, wrenches[:, padded], values, sense, mask, accurate, disabled
-            )
+                objective, wrenches[:, padded], values, sense, mask, accurate, disabled,
+                numbers[padded],
+            )  # fmt: skip
             results.append((result, len(index)))
             if progress is not None:
                 progress(min(start + block, cases), cases)
@@ -190,10 +197,11 @@ class Runner:
         return merged
 
     def _run_block(
-        self, objective, wrenches, given, sense, unloaded, accurate, disabled=None
+        self, objective, wrenches, given, sense, unloaded, accurate, disabled, numbers
     ) -> dict:
-        """One block: with osculating ellipsoids first where they apply, else (or where their
-        rounds do not settle) with cutting planes or no exact models at all."""
+        """One block (its load cases ``numbers`` among the problem's): with osculating
+        ellipsoids first where they apply, else (or where their rounds do not settle) with
+        cutting planes or no exact models at all."""
         for osculating in (True, False) if self.osculating else (False,):
             key = (objective, osculating)
             stacked = self.stacked(*key)
@@ -202,10 +210,18 @@ class Runner:
             direct = None if accurate or exact else self._direct_result(key, stacked)
             if direct is not None:
                 return direct
+            if osculating:
+                stacked.exact.place([self._ellipsoids.get(int(n)) for n in numbers])
             notes = []
             status, settled = self._solve(key, stacked, self.solver, accurate, notes)
-            if osculating and not (settled and status == "optimal"):
-                continue
+            if osculating:
+                placed = stacked.exact.ellipsoids
+                self._ellipsoids.update((int(n), placed[:, j]) for j, n in enumerate(numbers))
+                if not settled:
+                    continue
+                # Settled: the loads meet the exact problem's optimality conditions, checked
+                # here whatever the solver said of its accuracy.
+                return self._result(stacked, "optimal", self.solver, notes)
             solver = self.solver
             if status in ("solver-error", "inaccurate"):
                 fallback = _FALLBACK[solver]

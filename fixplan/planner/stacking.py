@@ -293,9 +293,13 @@ def build(
             limits = np.asarray(limits)
             variable = pieces[key][list(rows)]
             constraints.append(variable <= (limits[:, None] if key == "finger" else limits))
-    pool = OsculatingPool if layout.osculating else CutPool
-    exact = pool.of(layout.models, layout.slices, normal, friction,
-                    wrenches=layout.friction_map, balance=balance)  # fmt: skip
+    if layout.osculating:
+        exact = OsculatingPool.of(layout.models, layout.slices, normal, friction,
+                                  wrenches=layout.friction_map, balance=balance,
+                                  scale=scale if scaling else None)  # fmt: skip
+    else:
+        exact = CutPool.of(layout.models, layout.slices, normal, friction,
+                           wrenches=layout.friction_map, balance=balance)  # fmt: skip
     if exact is not None:
         constraints += exact.constraints
     unloaded = None
