@@ -16,7 +16,10 @@ inside its exact set (to ``EXACT_CUT_RTOL``), and each contact's twist in the im
 contact does not limit the optimum) is normal to the exact set at its load (``STATIONARITY_RTOL``)
 with the load on the exact surface (``COMPLEMENTARITY_RTOL``), each weighed by the twist's size
 relative to the largest. Loads of contacts that do not limit the optimum may be anywhere inside
-(an optimum's loads are often not unique). Rounds that do not get there (``MAX_ROUNDS``), or a
+(an optimum's loads are often not unique). A contact without load (not pressed) that takes part
+in the impending motion is held at no normal force because its set looks too small in the
+direction of its twist ``V``: its ellipsoid must reach as far as the exact set there
+(``SUPPORT_RTOL``), else it is moved to osculate at the exact set's point with normal ``V``. Rounds that do not get there (``MAX_ROUNDS``), or a
 solve that is not optimal (an ellipsoid can cut off a feasible load), leave the problem to the
 cutting planes, whose relaxations also certify infeasibility.
 """
@@ -43,6 +46,13 @@ STATIONARITY_RTOL = 1e-6
 #: Largest relative gap ``1 - 1/s`` of a load inside its exact set, times the size of its
 #: contact's twist relative to the largest (the ellipsoids' ``MARGIN`` leaves 1e-8).
 COMPLEMENTARITY_RTOL = 1e-7
+
+#: Largest relative shortfall ``1 - h_E(V) / h_1(V)`` of the support of an unpressed contact's
+#: ellipsoid below the exact set's in the direction of its twist ``V``, times the twist's size
+#: relative to the largest: where the ellipsoid reaches less far than the exact set, pressing the
+#: contact may lower the exact problem's objective (an osculated ellipsoid's shortfall is the
+#: ``MARGIN``).
+SUPPORT_RTOL = 1e-7
 
 #: Tangent-plane cuts per (contact, load case) besides the ellipsoid. A contact that does not
 #: limit the optimum can take any load of a face of optima, which an ellipsoid that is not
@@ -164,8 +174,10 @@ class OsculatingPool:
         per_unit = np.where(pressed, loads, 0.0) / np.where(pressed, forces, 1.0)  # (3, E, K)
         moving = pressed & (np.abs(per_unit).max(axis=0) > 0.0)
         self.use[:] = np.nan
+        settled = self._reach(twists, weights, ~pressed)
         if not moving.any():
-            return True
+            self._assign()
+            return settled
         found = [
             model.osculating(per_unit[:, e, moving[e]].T)
             for e, model in enumerate(self._models)
@@ -178,7 +190,7 @@ class OsculatingPool:
         exact_normals = _normals(factors, points)
         used = _normals(self._factors[owner, cases], per_unit)
         weight = weights[owner, cases]
-        settled = bool(
+        settled &= bool(
             np.all(excess <= EXACT_CUT_RTOL)
             and np.all(weight * _chord(used, exact_normals) <= STATIONARITY_RTOL)
             and np.all(weight * np.maximum(-excess, 0.0) <= COMPLEMENTARITY_RTOL)
@@ -195,6 +207,31 @@ class OsculatingPool:
             self._next_slot[e, k] = (slots + 1) % CUT_SLOTS
         self._assign()
         return settled
+
+    def _reach(self, twists: np.ndarray, weights: np.ndarray, idle: np.ndarray) -> bool:
+        """Whether the ellipsoids of the ``idle`` (unpressed) contacts reach as far as their
+        exact sets in the directions of their ``twists`` (``SUPPORT_RTOL``); those that fall
+        short are moved to osculate at the exact point with that normal."""
+        owner, cases = np.nonzero(idle & (weights > 0.0))
+        if owner.size == 0:
+            return True
+        loose = np.zeros(owner.size, dtype=bool)
+        for e in np.unique(owner):
+            rows = np.flatnonzero(owner == e)
+            model = self._models[e]
+            twist = twists[e, cases[rows]] / self._units[e]  # load-space twists
+            factors = self._factors[e, cases[rows]]
+            inverse = np.linalg.solve(factors.transpose(0, 2, 1), twist[:, :, None])
+            reach = np.linalg.norm(inverse[:, :, 0], axis=1)  # ellipsoid support ‖R⁻ᵀ V‖
+            exact = model.surface.support(twist) / model.surface.normal_force
+            loose[rows] = weights[e, cases[rows]] * (1.0 - reach / exact) > SUPPORT_RTOL
+            if loose[rows].any():
+                short = rows[loose[rows]]
+                points = model.surface.load(twist[loose[rows]]) / model.surface.normal_force
+                found = model.osculating(points)[2]
+                usable = np.all(np.isfinite(found), axis=(1, 2))
+                self._factors[e, cases[short[usable]]] = found[usable] * (1.0 + MARGIN)
+        return not loose.any()
 
     def _twists(self) -> np.ndarray:
         """``(E, K, 3)`` normalised twists ``(vx, vy, w) * units`` of the exact contacts in the
