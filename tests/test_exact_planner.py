@@ -349,3 +349,35 @@ def test_the_uses_kept_from_the_last_cutting_round_are_those_of_the_final_loads(
     asked = planner.friction_use(result["friction"], result["normal"], noise=noise)
     assert np.all(np.isfinite(known))
     np.testing.assert_allclose(known, asked, rtol=1e-12)
+
+
+def test_an_unpressed_exact_contact_whose_ellipsoid_falls_short_is_not_left_out(monkeypatch):
+    """At each finger of a pinch sit an exact 10:1 rectangle and an ellipsoid-model disk of the
+    same ``rho``. The load's direction at each finger is where the rectangle's exact set reaches
+    4 % beyond the ellipse through its axis points, and the disk's ellipsoid reaches 2 % beyond
+    that ellipse: the exact optimum presses the rectangles only, while a solve with the
+    rectangles' first ellipsoids presses the disks only. The rounds must not stop there (the
+    rectangles take no load, but their ellipsoids reach less far than their sets in the
+    direction of their twists)."""
+    rectangle = pressure.rectangle(0.1, 0.01)
+    rho = LimitSurface(rectangle, mu=1.0).characteristic_length
+    contacts = [
+        Contact(name=f"{kind}{side}", role="finger", position=[0, side * HALF_GAP, 0],
+                normal=[0, -side, 0], axis=[1, 0, 0], mu=mu, model=model, patch=patch)
+        for side in (-1, 1)
+        for kind, mu, model, patch in (("rectangle", 1.0, "exact", rectangle),
+                                       ("disk", 1.02, "ellipsoid", pressure.disk(1.5 * rho)))
+    ]  # fmt: skip
+    angle = 0.87  # of (f / F, m / M) on the rectangle's axis ellipse, its largest bulge
+    load = Load(name="turn", force=[20 * math.cos(angle), 0, 0], point=[0, 0, 0],
+                torque=[0, 20 * math.sin(angle) * rho, 0])  # fmt: skip
+    problem = Problem(body=Body(mass=0.0, center_of_mass=[0, 0, 0]), contacts=contacts,
+                      loads=[load], objective="min-total-normal-force")  # fmt: skip
+    planner = Planner(problem)
+    plan = planner.solve(analyse=False)
+    monkeypatch.setattr(runner, "smooth", lambda models: False)
+    reference = Planner(problem).solve(analyse=False)
+    assert plan.status == reference.status == "optimal"
+    assert plan.objective_value == pytest.approx(reference.objective_value, rel=OPTIMUM_RTOL)
+    np.testing.assert_allclose(plan.normal_forces[[1, 3], 0], 0.0, atol=1e-6)  # the disks
+    assert (problem.objective, False) not in planner._runner._built  # settled, no fallback

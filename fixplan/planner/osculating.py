@@ -18,7 +18,11 @@ with the load on the exact surface (``COMPLEMENTARITY_RTOL``), each weighed by t
 relative to the largest (of the load case, for the fixed-force objectives, whose cases are
 independent). Loads of contacts that do not limit the optimum may be anywhere inside (an
 optimum's loads are often not unique). A fixed-force case whose multiple sits at a bound (0, or
-the cap) needs no stationarity: its exactly feasible loads prove that multiple optimal. Rounds that do not get there (``MAX_ROUNDS``), or a
+the cap) needs no stationarity: its exactly feasible loads prove that multiple optimal. A
+contact without load (not pressed) that takes part in the impending motion is held at no normal
+force because its set looks too small in the direction of its twist ``V``: its ellipsoid must
+reach as far as the exact set there (``SUPPORT_RTOL``), else it is moved to osculate at the
+exact set's point with normal ``V``. Rounds that do not get there (``MAX_ROUNDS``), or a
 solve that is not optimal (an ellipsoid can cut off a feasible load), leave the problem to the
 cutting planes, whose relaxations also certify infeasibility.
 """
@@ -53,6 +57,20 @@ STATIONARITY_RTOL = 1e-6
 #: benchmarks/bench_exact.py); an ellipsoid whose normal agrees with the exact one
 #: (``STATIONARITY_RTOL``) but that holds a load back leaves far more.
 COMPLEMENTARITY_RTOL = 1e-5
+
+#: Largest relative shortfall ``1 - h_E(V) / h_1(V)`` of the support of an unpressed contact's
+#: ellipsoid below the exact set's in the direction of its twist ``V``, times the twist's size
+#: relative to the largest: where the ellipsoid reaches less far than the exact set, pressing the
+#: contact may lower the exact problem's objective (an osculated ellipsoid's shortfall is the
+#: ``MARGIN``).
+SUPPORT_RTOL = 1e-7
+
+#: Smallest largest normalised twist (``V * units``, dimensionless) of a force objective that
+#: counts as a limiting contact's: the objective changes by one per newton of each free normal
+#: force, so a contact that limits it has a twist of about ``mu / K`` (``K`` load cases sharing
+#: the force); where the optimum needs no force at all, the twists are solver noise (about
+#: 1e-11), which this keeps from being weighed as limiting.
+FORCE_DUAL_FLOOR = 1e-6
 
 #: Tangent-plane cuts per (contact, load case) besides the ellipsoid. A contact that does not
 #: limit the optimum can take any load of a face of optima, which an ellipsoid that is not
@@ -193,8 +211,10 @@ class OsculatingPool:
         per_unit = np.where(pressed, loads, 0.0) / np.where(pressed, forces, 1.0)  # (3, E, K)
         moving = pressed & (np.abs(per_unit).max(axis=0) > 0.0)
         self.use[:] = np.nan
+        settled = self._reach(twists, weights, ~pressed)
         if not moving.any():
-            return True
+            self._assign()
+            return settled
         found = [
             model.osculating(per_unit[:, e, moving[e]].T)
             for e, model in enumerate(self._models)
@@ -209,7 +229,7 @@ class OsculatingPool:
         limiting = weights[owner, cases] > 0.0  # (a NaN normal elsewhere does not matter)
         weight = weights[owner, cases][limiting]
         gap = weight * _chord(used[limiting], exact_normals[limiting])
-        settled = bool(
+        settled &= bool(
             np.all(excess <= EXACT_CUT_RTOL)
             and np.all(gap <= STATIONARITY_RTOL)
             and np.all(weight * np.maximum(-excess[limiting], 0.0) <= COMPLEMENTARITY_RTOL)
@@ -231,11 +251,36 @@ class OsculatingPool:
         """``(E, K)`` twist sizes relative to the largest (per case for fixed-force objectives,
         0 where the case's multiple sits at a bound)."""
         if self._scale is None:
-            return sizes / max(float(sizes.max(initial=0.0)), 1e-300)
+            return sizes / max(float(sizes.max(initial=0.0)), FORCE_DUAL_FLOOR)
         weights = sizes / np.maximum(sizes.max(axis=0, initial=0.0), 1e-300)
         multiples = np.asarray(self._scale.value, dtype=float)
         weights[:, (multiples <= MULTIPLE_ATOL) | (multiples >= MAX_SAFETY_FACTOR * (1 - 1e-6))] = 0
         return weights
+
+    def _reach(self, twists: np.ndarray, weights: np.ndarray, idle: np.ndarray) -> bool:
+        """Whether the ellipsoids of the ``idle`` (unpressed) contacts reach as far as their
+        exact sets in the directions of their ``twists`` (``SUPPORT_RTOL``); those that fall
+        short are moved to osculate at the exact point with that normal."""
+        owner, cases = np.nonzero(idle & (weights > 0.0))
+        if owner.size == 0:
+            return True
+        loose = np.zeros(owner.size, dtype=bool)
+        for e in np.unique(owner):
+            rows = np.flatnonzero(owner == e)
+            model = self._models[e]
+            twist = twists[e, cases[rows]] / self._units[e]  # load-space twists
+            factors = self._factors[e, cases[rows]]
+            inverse = np.linalg.solve(factors.transpose(0, 2, 1), twist[:, :, None])
+            reach = np.linalg.norm(inverse[:, :, 0], axis=1)  # ellipsoid support ‖R⁻ᵀ V‖
+            exact = model.surface.support(twist) / model.surface.normal_force
+            loose[rows] = weights[e, cases[rows]] * (1.0 - reach / exact) > SUPPORT_RTOL
+            if loose[rows].any():
+                short = rows[loose[rows]]
+                points = model.surface.load(twist[loose[rows]]) / model.surface.normal_force
+                found = model.osculating(points)[2]
+                usable = np.all(np.isfinite(found), axis=(1, 2))
+                self._factors[e, cases[short[usable]]] = found[usable] * (1.0 + MARGIN)
+        return not loose.any()
 
     def _twists(self) -> np.ndarray:
         """``(E, K, 3)`` normalised twists ``(vx, vy, w) * units`` of the exact contacts in the
