@@ -1,0 +1,244 @@
+"""The tactile-grid kernel holds each edge of the lattice of cell corners once, weighted by the
+pressure on its left minus that on its right, and equals the kernel of every loaded cell's own
+four edges (how the grid kernel was built before edges were merged).
+
+Reference: :func:`four_edges_per_cell` builds that unmerged kernel here, from the field's cell
+centres and values; merging changes only the order and grouping of a sum of the same terms, so
+values, loads and Hessians agree to rounding (:data:`KERNEL_RTOL`). The far-field Gauss rule is
+not merged: the reference uses the same rule.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fixplan import LimitSurface, pressure
+from fixplan.surface import limit_surface
+from fixplan.surface.kernels import PosedKernel
+from fixplan.surface.point_kernel import PointSetKernel
+from fixplan.surface.polygon_kernel import EdgeSumKernel
+from fixplan.tolerances import FAR_FIELD_RADII, INVERSE_RTOL
+
+#: Merged against unmerged kernel, per twist: support value relative to itself, load and Hessian
+#: (moments divided by the patch size) relative to their largest component. Rounding of sums of
+#: up to a few thousand terms is ~1e-14.
+KERNEL_RTOL = 1e-12
+#: Safety factors through the inverse map: Newton stops when the twist is within about
+#: INVERSE_RTOL, which leaves the safety factor within its square; rounding dominates.
+SAFETY_RTOL = 1e-12
+#: Unit motions through the inverse map: the twist is within about INVERSE_RTOL of the solution,
+#: amplified by the conditioning of the normal map (up to 2e-11 measured on these grids).
+MOTION_ATOL = 1e3 * INVERSE_RTOL
+DX, DY = 0.002, 0.003  # cell size [m]; unequal to catch swapped axes
+
+
+def random_values(ny: int, nx: int, seed: int) -> np.ndarray:
+    """Random pressures with about a fifth of the cells zero, a plateau of 2 x 3 equal cells and
+    a pair of equal neighbours."""
+    rng = np.random.default_rng(seed)
+    values = rng.uniform(0.2, 2.0, size=(ny, nx))
+    values[rng.random((ny, nx)) < 0.2] = 0.0
+    values[1:3, 2:5] = 1.25
+    values[ny - 1, nx - 2 :] = 0.75
+    return values
+
+
+def hertz_values(ny: int, nx: int) -> np.ndarray:
+    """A Hertz-like map over an ellipse inside the grid, zero outside it."""
+    y, x = np.meshgrid(np.linspace(-1, 1, ny), np.linspace(-1, 1, nx), indexing="ij")
+    return np.sqrt(np.clip(1.0 - (x * x + y * y) / 0.85**2, 0.0, None))
+
+
+def lone(ny: int, nx: int, rows: slice, columns: slice, seed: int) -> np.ndarray:
+    """Zeros except distinct random pressures on ``values[rows, columns]``."""
+    values = np.zeros((ny, nx))
+    block = values[rows, columns]
+    block[...] = np.random.default_rng(seed).uniform(0.5, 1.5, size=block.shape)
+    return values
+
+
+def make_grid(values: np.ndarray) -> pressure.GridField:
+    ny, nx = values.shape
+    return pressure.grid(DX * np.arange(nx), DY * np.arange(ny), values)
+
+
+GRIDS = {
+    "random with zeros and equal neighbours": lambda: make_grid(random_values(7, 9, 1)),
+    "uniform plateau": lambda: make_grid(np.ones((5, 6))),
+    "one loaded cell": lambda: make_grid(lone(3, 3, slice(1, 2), slice(1, 2), 2)),
+    "one row of 7 cells": lambda: make_grid(lone(3, 7, slice(1, 2), slice(0, 7), 3)),
+    "one column of 5 cells": lambda: make_grid(lone(5, 2, slice(0, 5), slice(1, 2), 4)),
+    "Hertz map of 30 x 40 cells": lambda: make_grid(hertz_values(30, 40)),
+    "posed random grid": lambda: (
+        make_grid(random_values(6, 8, 5)).rotated(0.7, about=(0.003, -0.002)).shifted(0.01, -0.02)
+    ),
+}
+
+
+def far_rule(field: pressure.GridField) -> PointSetKernel:
+    """The Gauss rule of the cells for far centres of rotation (order as the grid kernel's)."""
+    cells = np.count_nonzero(field.values > 0.0)
+    order = 8 if cells <= 16 else 4 if cells <= 256 else 3
+    return PointSetKernel(*field._local_quadrature(order))
+
+
+def four_edges_per_cell(field: pressure.GridField) -> EdgeSumKernel:
+    """The unmerged grid kernel: each loaded cell's counter-clockwise boundary with its pressure
+    [1/m²], in the grid's local frame."""
+    dx, dy = field.cell_size
+    rows, columns = np.nonzero(field.values > 0.0)
+    loads = field.values[rows, columns]
+    centres = np.column_stack([field.x[columns], field.y[rows]])
+    corners = np.array([[-dx, -dy], [dx, -dy], [dx, dy], [-dx, dy]]) / 2.0
+    squares = centres[:, None, :] + corners[None, :, :]
+    starts = squares.reshape(-1, 2)
+    ends = np.roll(squares, -1, axis=1).reshape(-1, 2)
+    weights = np.repeat(loads / loads.sum() / (dx * dy), 4)
+    return EdgeSumKernel(starts, ends, weights, far_rule(field))
+
+
+def merged_and_unmerged_kernels(field, monkeypatch):
+    """The library's kernel of ``field`` and the same with :func:`four_edges_per_cell`."""
+    merged = limit_surface._field_kernel(field)
+    with monkeypatch.context() as patch:
+        patch.setattr(limit_surface, "_grid_kernel", four_edges_per_cell)
+        unmerged = limit_surface._field_kernel(field)
+    return merged, unmerged
+
+
+def lattice_edges(field: pressure.GridField) -> dict:
+    """Merged weights [1/m²] by lattice edge, summed cell by cell in plain Python: keys
+    ``((i, k), (i', k'))`` with the corners in increasing order, weights for that direction."""
+    dx, dy = field.cell_size
+    _, fractions = field.cells()
+    rows, columns = np.nonzero(field.values > 0.0)
+    edges = {}
+    for k, i, fraction in zip(rows.tolist(), columns.tolist(), fractions.tolist(), strict=True):
+        p = fraction / (dx * dy)
+        corners = [(i, k), (i + 1, k), (i + 1, k + 1), (i, k + 1)]
+        for a, b in zip(corners, corners[1:] + corners[:1], strict=True):
+            key, sign = ((a, b), 1.0) if a < b else ((b, a), -1.0)
+            edges[key] = edges.get(key, 0.0) + sign * p
+    return {key: weight for key, weight in edges.items() if weight != 0.0}
+
+
+def table_edges(kernel: EdgeSumKernel, field: pressure.GridField) -> dict:
+    """The kernel's edge table as in :func:`lattice_edges` (corners rounded to the lattice)."""
+    dx, dy = field.cell_size
+    table = kernel.edge_table
+    origin = np.array([field.x[0] - dx / 2, field.y[0] - dy / 2])
+    starts = np.rint((table[0:2].T - origin) / (dx, dy)).astype(int)
+    ends = np.rint((table[2:4].T - origin) / (dx, dy)).astype(int)
+    edges = {}
+    for a, b, weight in zip(map(tuple, starts), map(tuple, ends), table[6], strict=True):
+        key, sign = ((a, b), 1.0) if a < b else ((b, a), -1.0)
+        assert key not in edges, f"edge {key} appears twice"
+        assert np.sum(np.abs(np.subtract(b, a))) == 1, f"edge {key} is not one cell side"
+        edges[key] = sign * weight
+    return edges
+
+
+def twists(field, seed: int) -> np.ndarray:
+    """Rotations about points inside the grid (random, at and next to cell corners, on cell
+    sides), about centres out to past the far-field radius, nearly pure and pure translations;
+    contact frame."""
+    rng = np.random.default_rng(seed)
+    points, _ = field.quadrature(2)
+    low, high = points.min(axis=0), points.max(axis=0)
+    size = float(np.max(np.linalg.norm(points - field.center, axis=1)))
+    dx, dy = field.cell_size
+    centres = field.cells()[0][:4]
+    corners = field.pose.apply(np.vstack([centres + [dx / 2, -dy / 2], centres - [0, dy / 2]]))
+    next_to_corners = corners + 1e-9 * size * rng.normal(size=corners.shape)
+    inside = np.vstack([rng.uniform(low, high, size=(20, 2)), corners, next_to_corners])
+    outside = field.center + rng.normal(size=(20, 2)) * size * rng.uniform(0.5, 6.0, (20, 1))
+    cors = np.vstack([inside, outside])
+    rates = rng.choice([-1.0, 1.0], size=len(cors)) * rng.uniform(0.5, 20.0, size=len(cors))
+    rotations = rates[:, None] * np.column_stack([cors[:, 1], -cors[:, 0], np.ones(len(cors))])
+    velocities = rng.normal(size=(10, 2))
+    translations = np.hstack([velocities, 1e-7 / size * rng.normal(size=(10, 1))])
+    return np.vstack([rotations, translations, [[1.0, -0.5, 0.0]]])
+
+
+@pytest.mark.parametrize("name", GRIDS)
+def test_each_lattice_edge_is_kept_once_with_the_left_minus_right_pressure(name, monkeypatch):
+    field = GRIDS[name]()
+    merged, _ = merged_and_unmerged_kernels(field, monkeypatch)
+    local = merged.local if isinstance(merged, PosedKernel) else merged
+    assert table_edges(local, field) == lattice_edges(field)
+
+
+@pytest.mark.parametrize(
+    ("name", "count"),
+    [
+        ("uniform plateau", 2 * (5 + 6)),
+        ("one loaded cell", 4),
+        ("one row of 7 cells", 2 * 7 + 8),
+        ("one column of 5 cells", 2 * 5 + 6),
+    ],
+)
+def test_grids_keep_only_the_edges_between_unequal_pressures(name, count, monkeypatch):
+    field = GRIDS[name]()
+    merged, _ = merged_and_unmerged_kernels(field, monkeypatch)
+    assert merged.edge_table.shape[1] == count
+
+
+def test_a_uniform_plateau_keeps_its_outer_boundary_at_the_cell_pressure(monkeypatch):
+    field = GRIDS["uniform plateau"]()
+    merged, _ = merged_and_unmerged_kernels(field, monkeypatch)
+    table = merged.edge_table
+    dx, dy = field.cell_size
+    np.testing.assert_allclose(np.abs(table[6]), 1.0 / (30 * dx * dy), rtol=1e-15)
+    x, y = table[[0, 2]], table[[1, 3]]
+    on_boundary = np.isclose(x, field.x[0] - dx / 2) | np.isclose(x, field.x[-1] + dx / 2)
+    on_boundary |= np.isclose(y, field.y[0] - dy / 2) | np.isclose(y, field.y[-1] + dy / 2)
+    assert np.all(on_boundary)
+
+
+def errors(size, terms, reference):
+    """Per twist: relative errors of the support values, and of the loads and Hessians in the
+    coordinates ``(vx, vy, size * w)`` (moments divided by ``size``) relative to their largest
+    component; for ``(h, load[, hessian])`` from ``evaluate`` or ``newton_terms``."""
+    d = np.array([1.0, 1.0, 1.0 / size])
+    h, h_ref = terms[0], reference[0]
+    result = [np.abs(h - h_ref) / np.abs(h_ref)]
+    for value, value_ref, scale in zip(terms[1:], reference[1:], [d, np.outer(d, d)], strict=False):
+        axes = tuple(range(1, value.ndim))
+        result.append(
+            np.max(np.abs((value - value_ref) * scale), axis=axes)
+            / np.max(np.abs(value_ref * scale), axis=axes)
+        )
+    return result
+
+
+@pytest.mark.parametrize("name", GRIDS)
+def test_merged_kernel_equals_the_four_edges_per_cell_kernel(name, monkeypatch):
+    field = GRIDS[name]()
+    merged, unmerged = merged_and_unmerged_kernels(field, monkeypatch)
+    batch = twists(field, seed=len(name))
+    near = FAR_FIELD_RADII * merged.size * np.abs(batch[:, 2]) > np.hypot(batch[:, 0], batch[:, 1])
+    assert np.count_nonzero(near) >= 40 and np.count_nonzero(~near) >= 10
+    for method in ("evaluate", "newton_terms"):
+        terms, reference = getattr(merged, method)(batch), getattr(unmerged, method)(batch)
+        names = ["value", "load", "Hessian"][: len(terms)]
+        for what, error in zip(names, errors(merged.size, terms, reference), strict=True):
+            assert np.max(error) < KERNEL_RTOL, f"{method}: {what} off by {np.max(error):.1e}"
+
+
+@pytest.mark.parametrize("name", ["random with zeros and equal neighbours", "posed random grid"])
+def test_safety_factors_and_motions_match_the_four_edges_per_cell_surface(name, monkeypatch):
+    field = GRIDS[name]()
+    surface = LimitSurface(field, mu=0.5, normal_force=20.0)
+    with monkeypatch.context() as patch:
+        patch.setattr(limit_surface, "_grid_kernel", four_edges_per_cell)
+        reference = LimitSurface(field, mu=0.5, normal_force=20.0)
+    rng = np.random.default_rng(7)
+    loads = rng.normal(size=(40, 3)) * rng.uniform(0.3, 2.0, size=(40, 1))
+    loads *= np.array([surface.max_force, surface.max_force, surface.max_moment])
+    motion, safety = surface.motion_and_safety_factor(loads)
+    motion_ref, safety_ref = reference.motion_and_safety_factor(loads)
+    np.testing.assert_allclose(safety, safety_ref, rtol=SAFETY_RTOL, atol=0.0)
+    np.testing.assert_allclose(motion, motion_ref, rtol=0.0, atol=MOTION_ATOL)
+    np.testing.assert_array_equal(surface.safety_factor(loads[:5]), safety[:5])
+    np.testing.assert_array_equal(surface.motion(loads[:5]), motion[:5])
