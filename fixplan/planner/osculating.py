@@ -72,10 +72,13 @@ SUPPORT_RTOL = 1e-7
 #: 1e-11), which this keeps from being weighed as limiting.
 FORCE_DUAL_FLOOR = 1e-6
 
-#: Tangent-plane cuts per (contact, load case) besides the ellipsoid. A contact that does not
-#: limit the optimum can take any load of a face of optima, which an ellipsoid that is not
-#: outer may leave outside the exact set; its cut (the tangent plane at that load's ray, valid
-#: for the exact set) keeps the next solve from it. New cuts replace the oldest.
+#: Tangent-plane cuts per (contact, load case) besides the ellipsoid: each load outside its
+#: exact set leaves the tangent plane at its ray (valid for the exact set), which keeps later
+#: solves from it; new cuts replace the oldest. Without them, loads of contacts that do not limit
+#: the optimum (any of a face of optima) and, far from the optimum, limiting loads too swing
+#: between points outside their sets (on the fixture of benchmarks/bench_exact.py a check block
+#: did not settle in 12 rounds). One slot is not enough there either; each slot costs a row per
+#: contact and case (2 slots: 6.2 ms of Clarabel per round against 2.9 ms without).
 CUT_SLOTS = 2
 
 #: Ellipsoids are tightened by this fraction (``(1 + MARGIN) ‖R ℓ‖ <= n``), so that the solver's
