@@ -107,9 +107,12 @@ class Runner:
         #: where those rounds do not settle.
         self.osculating = solver == "CLARABEL" and smooth(layout.models)
         self._layouts = {False: layout}
-        # The last ellipsoids (E, 3, 3) of each load case, whichever program placed them: the
-        # next program that solves the case starts from them.
-        self._ellipsoids: dict[int, np.ndarray] = {}
+        # The last ellipsoids (E, 3, 3) of each load case, whichever program placed them, and of
+        # each (objective, sense, load case), with the task wrench they were placed for. A
+        # program starts from those placed for the same wrench, its own first (a re-solve with
+        # the same loads), else the latest (a check after a force objective with new loads);
+        # for a new wrench, from its own (loads that change smoothly).
+        self._ellipsoids: dict = {}
         if self.osculating:
             self._layouts[True] = ContactLayout.of(problem, list(layout.models), osculating=True)
         #: Whether the fixed-force programs are linear (pyramid models): their cases are then
@@ -211,12 +214,12 @@ class Runner:
             if direct is not None:
                 return direct
             if osculating:
-                stacked.exact.place([self._ellipsoids.get(int(n)) for n in numbers])
+                cases = [(objective, sense, n, wrenches[:, j]) for j, n in enumerate(numbers)]
+                stacked.exact.place([self._start(*case) for case in cases])
             notes = []
             status, settled = self._solve(key, stacked, self.solver, accurate, notes)
             if osculating:
-                placed = stacked.exact.ellipsoids
-                self._ellipsoids.update((int(n), placed[:, j]) for j, n in enumerate(numbers))
+                self._remember(cases, stacked.exact.ellipsoids)
                 if not settled:
                     continue
                 # Settled: the loads meet the exact problem's optimality conditions, checked
@@ -229,6 +232,23 @@ class Runner:
                 solver = fallback
                 status, _ = self._solve(key, stacked, solver, False, notes)
             return self._result(stacked, status, solver, notes)
+
+    def _start(self, objective, sense, case, wrench: np.ndarray) -> np.ndarray | None:
+        """The ellipsoids ``(E, 3, 3)`` a program starts from for ``case`` (see ``__init__``)."""
+        own = self._ellipsoids.get((objective, sense, int(case)))
+        latest = self._ellipsoids.get(int(case))
+        for kept in (own, latest):
+            if kept is not None and np.array_equal(kept[0], wrench):
+                return kept[1]
+        kept = own if own is not None else latest
+        return None if kept is None else kept[1]
+
+    def _remember(self, cases: list, ellipsoids: np.ndarray) -> None:
+        """Keep the ellipsoids ``(E, K, 3, 3)`` a program placed for its ``cases``
+        (``(objective, sense, case, wrench)`` each)."""
+        for j, (objective, sense, case, wrench) in enumerate(cases):
+            kept = (wrench.copy(), ellipsoids[:, j])
+            self._ellipsoids[int(case)] = self._ellipsoids[(objective, sense, int(case))] = kept
 
     def _set_parameters(self, key, stacked, wrenches, given, sense, unloaded, disabled) -> None:
         assign(stacked.task, wrenches)
