@@ -13,6 +13,10 @@ of
 - the baseline: cvxpy + Clarabel re-solving the planner's compiled problem (parameters set,
   ``problem.solve``), with nothing else, in the same run.
 
+The exact model (osculating ellipsoids, :mod:`fixplan.planner.osculating`) is timed on the first
+twentieth of the path, against the ellipsoid's figures of the same run, with the mean number
+of rounds per solve.
+
 The machine's load average is printed with the figures (other processes slow these
 single-threaded runs).
 """
@@ -69,6 +73,7 @@ def main() -> None:
     count = parser.parse_args().count
     path = loads(count)
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores; {count} re-solves")
+    medians = {}
     for model in MODELS:
         problem = fixture(model, "min-total-clamp-force", path[0])
         planner = Planner(problem)
@@ -90,6 +95,7 @@ def main() -> None:
             f"{np.median(bare) / np.median(raw):.2f}, with analysis / solve "
             f"{np.median(analysed) / np.median(bare):.2f} (solver {plan.solver}, {plan.status})"
         )
+        medians[model] = (np.median(bare), np.median(analysed))
         emit(
             f"grasp re-solve, 8 contacts × 1 case, {model}, {count:,} smoothly changing loads "
             "(median, p99): bare; with the safety analysis",
@@ -98,6 +104,38 @@ def main() -> None:
             f"{np.median(bare) / np.median(raw):.2f}×; analysis / bare "
             f"{np.median(analysed) / np.median(bare):.2f}×",
         )
+
+    exact_row(path[: max(count // 20, 10)], medians["ellipsoid"])
+
+
+def exact_row(path: list, ellipsoid: tuple[float, float]) -> None:
+    """The exact model on the same grasp, against the ellipsoid's medians (bare, analysed)."""
+    from fixplan.planner import osculating
+
+    rounds = []
+    move = osculating.OsculatingPool.move
+    osculating.OsculatingPool.move = lambda pool: rounds.append(1) or move(pool)
+    planner = Planner(fixture("exact", "min-total-clamp-force", path[0]))
+    for warm in path[:3]:
+        planner.solve(warm)
+    rounds.clear()
+    bare = timings(lambda x: planner.solve(x, analyse=False), path)
+    per_bare = len(rounds) / len(path)
+    rounds.clear()
+    analysed = timings(planner.solve, path)
+    per_analysed = len(rounds) / len(path)
+    osculating.OsculatingPool.move = move
+    ratios = np.median(bare) / ellipsoid[0], np.median(analysed) / ellipsoid[1]
+    print(f"{'exact':10s} solve {figures(bare)} ({per_bare:.1f} rounds); with analysis "
+          f"{figures(analysed)} ({per_analysed:.1f} rounds); / ellipsoid {ratios[0]:.1f}, "
+          f"{ratios[1]:.1f}")  # fmt: skip
+    emit(
+        f"grasp re-solve, 8 contacts × 1 case, exact, {len(path):,} smoothly changing loads "
+        "(median, p99): bare; with the safety analysis (rounds of osculating ellipsoids)",
+        f"{figures(bare)} ({per_bare:.1f}); {figures(analysed)} ({per_analysed:.1f})",
+        f"ellipsoid of the same run: median {ellipsoid[0] * 1e3:.3f} ms; {ellipsoid[1] * 1e3:.3f} ms",
+        f"{ratios[0]:.0f}×; {ratios[1]:.0f}×",
+    )
 
 
 if __name__ == "__main__":
