@@ -11,11 +11,13 @@ constant factor per round. Each round is a conic problem of the size of the elli
 
 The ellipsoids are not outer approximations, so a round is not a relaxation: the rounds stop
 when the solve meets the optimality conditions of the exact problem. Every contact load lies
-inside its exact set (to ``EXACT_CUT_RTOL``), and each contact's twist in the impending motion
-(the equilibrium's multipliers mapped to the contact, ``V_ij = -G_iᵀ y_j``, zero where the
-contact does not limit the optimum) is normal to the exact set at its load (``STATIONARITY_RTOL``)
-with the load on the exact surface (``COMPLEMENTARITY_RTOL``), each weighed by the twist's size
-relative to the largest (of the load case, for the fixed-force objectives, whose cases are
+inside its exact set (to ``EXACT_CUT_RTOL``); where a contact limits the optimum (its twist in
+the impending motion, the equilibrium's multipliers mapped to the contact, ``V_ij = -G_iᵀ y_j``,
+is not zero), the solve made that twist the normal of the ellipsoid it used at the load, so
+that ellipsoid's normal there must be the exact set's (``STATIONARITY_RTOL``; the normals are
+compared rather than the twist, whose direction an interior-point solve gives to about 1e-5)
+and the load must lie on the exact surface (``COMPLEMENTARITY_RTOL``), each weighed by the
+twist's size relative to the largest (of the load case, for the fixed-force objectives, whose cases are
 independent). Loads of contacts that do not limit the optimum may be anywhere inside (an
 optimum's loads are often not unique). A fixed-force case whose multiple sits at a bound (0, or
 the cap) needs no stationarity: its exactly feasible loads prove that multiple optimal. A
@@ -46,9 +48,9 @@ from fixplan.tolerances import (
 #: Most solves of one problem; a problem not settled by then goes to the cutting planes.
 MAX_ROUNDS = 12
 
-#: Largest distance between the unit directions (normalised coordinates) of a contact's twist
-#: in the impending motion and of the exact set's normal at its load, times the twist's size
-#: relative to the largest.
+#: Largest distance between the unit normals (normalised coordinates) of the ellipsoid a solve
+#: used and of the exact set at a contact's load, times the size of the contact's twist in the
+#: impending motion relative to the largest.
 STATIONARITY_RTOL = 1e-6
 
 #: Largest relative gap ``1 - 1/s`` of a load inside its exact set, times the size of its
