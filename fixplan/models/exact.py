@@ -134,8 +134,10 @@ class Exact(FrictionModel):
         support is read from the inverse map's answer instead of being integrated again
         (relative difference about 1e-14, far below the planner's ``CUT_MARGIN``).
         """
-        excess, planes = self._cut_terms(loads)
-        return planes, excess
+        twists, safety = self.surface.motion_and_safety_factor(loads * self.surface.normal_force)
+        twists, safety = np.atleast_2d(twists), np.atleast_1d(safety)
+        support = safety * np.einsum("ij,ij->i", loads, twists)
+        return twists / support[:, None], 1.0 / safety - 1.0
 
     def osculating(self, loads: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         r"""The ellipsoid that osculates the exact set where the ray of each load meets it.
@@ -165,7 +167,7 @@ class Exact(FrictionModel):
         the same value, gradient and Hessian at ``u``. The algebra runs in normalised
         coordinates (loads over :meth:`_units`), where ``J`` is well conditioned.
         """
-        excess, planes = self._cut_terms(loads)
+        planes, excess = self.cut(loads)
         units = self._units()
         points = loads / (1.0 + excess)[:, None]
         a, u = planes * units, points / units  # normalised plane and point, a · u = 1
@@ -174,13 +176,6 @@ class Exact(FrictionModel):
         factors = np.empty((len(loads), 3, 3))
         _OSCULATING_FACTORS(a, u, curvature, factors)
         return excess, points, factors / units[None, None, :]
-
-    def _cut_terms(self, loads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Excess ``1 / s - 1`` and tangent planes ``V / h_1(V)`` of loads ``(K, 3)``."""
-        twists, safety = self.surface.motion_and_safety_factor(loads * self.surface.normal_force)
-        twists, safety = np.atleast_2d(twists), np.atleast_1d(safety)
-        support = safety * np.einsum("ij,ij->i", loads, twists)
-        return 1.0 / safety - 1.0, twists / support[:, None]
 
     def planes(self, twists: np.ndarray) -> np.ndarray:
         r"""Tangent planes :math:`a \cdot L \le N`, ``a = V / h_1(V)``, of the exact set at the

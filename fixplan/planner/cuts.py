@@ -36,11 +36,9 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-import cvxpy as cp
 import numpy as np
-import scipy.sparse as sp
 
-from fixplan.models.exact import Exact
+from fixplan.planner.exact_contacts import ExactContacts
 from fixplan.tolerances import EXACT_CUT_RTOL, FRICTION_SET_RTOL
 
 #: Cut rows per (exact contact, load case) besides the seed polytope.
@@ -72,68 +70,17 @@ CUT_MARGIN = 1e-8
 ACTIVE_RTOL = 1e-7
 
 
-class CutPool:
-    """The cut Parameters of a stacked problem's exact contacts, and the rounds of cutting.
+class CutPool(ExactContacts):
+    """The cut Parameters of a stacked problem's exact contacts, and the rounds of cutting
+    (``CUT_SLOTS`` per contact and load case; the other parameters are those of
+    :class:`~fixplan.planner.exact_contacts.ExactContacts`)."""
 
-    Parameters
-    ----------
-    models : dict
-        Contact index -> its :class:`~fixplan.models.Exact` model (frictionless ones excluded).
-    slices : tuple of slice
-        Rows of each contact's friction load in the stacked friction variable.
-    normal : cvxpy.Expression
-        ``(C, K)`` normal forces [N].
-    friction : cvxpy.Variable
-        ``(D, K)`` friction loads.
-    wrenches : numpy.ndarray
-        ``(6, D)`` body wrench per unit friction load component (the equilibrium's ``G``).
-    balance : cvxpy.Constraint
-        The equilibrium; its multipliers ``(6, K)`` are the impending motion of each case.
-    """
-
-    def __init__(
-        self,
-        models: dict,
-        slices,
-        normal: cp.Expression,
-        friction: cp.Variable,
-        *,
-        wrenches: np.ndarray,
-        balance: cp.Constraint,
-    ):
-        self._contacts = np.array(sorted(models), dtype=int)
-        self._models = [models[i] for i in self._contacts]
-        self._rows = np.array([np.arange(slices[i].start, slices[i].stop) for i in self._contacts])
-        self._normal, self._friction = normal, friction
-        self._wrenches = np.array([wrenches[:, rows] for rows in self._rows])  # (E, 6, 3)
-        self._balance = balance
-        count, cases = len(self._contacts), friction.shape[1]
-        self._planes = np.zeros((3, CUT_SLOTS, count, cases))
-        self._used = np.full((CUT_SLOTS, count, cases), -1, dtype=np.int64)
+    def __init__(self, models: dict, slices, normal, friction, *, wrenches, balance):
+        super().__init__(models, slices, normal, friction, wrenches=wrenches, balance=balance,
+                         slots=CUT_SLOTS, name="cut")  # fmt: skip
+        self._used = np.full((CUT_SLOTS, len(self._contacts), friction.shape[1]), -1, np.int64)
         self._round = 0
-        #: ``(C, K)`` friction use ``1 / s`` of every exact contact's load in the last solve that
-        #: :meth:`add_cuts` checked (NaN for other contacts and unpressed ones): the solve's
-        #: final loads, whose exact safety factors verification need not ask for again.
-        self.use = np.full((normal.shape[0], cases), np.nan)
-        self._parameters = [
-            cp.Parameter((CUT_SLOTS * count, cases), name=f"cut_{axis}", value=np.zeros(
-                (CUT_SLOTS * count, cases)))
-            for axis in ("fx", "fy", "m")
-        ]  # fmt: skip
-        tile = sp.vstack([sp.eye_array(count)] * CUT_SLOTS, format="csr")
-        lhs = sum(
-            cp.multiply(parameter, tile @ friction[self._rows[:, axis], :])
-            for axis, parameter in enumerate(self._parameters)
-        )
-        self.constraints = [lhs <= tile @ normal[self._contacts, :]]
-
-    @classmethod
-    def of(cls, models, slices, normal, friction, *, wrenches, balance) -> CutPool | None:
-        """The pool of the exact models among ``models`` (one per contact), or ``None``."""
-        exact = {i: m for i, m in enumerate(models) if isinstance(m, Exact) and not m.frictionless}
-        if not exact:
-            return None
-        return cls(exact, slices, normal, friction, wrenches=wrenches, balance=balance)
+        self.constraints = [self._cuts]
 
     def converge(self, solve: Callable[[], str], status: str) -> tuple[str, list[str]]:
         """Cut and re-solve (``solve()`` returns the status) from a first solve's ``status``
@@ -198,19 +145,16 @@ class CutPool:
             for rows, slots in zip(new, order[: len(new)], strict=True):
                 self._planes[:, slots, e, cases] = rows.T * (1.0 + CUT_MARGIN)
                 self._used[slots, e, cases] = self._round
-        shape = self._parameters[0].shape
-        for axis, parameter in enumerate(self._parameters):
-            parameter.value = self._planes[axis].reshape(shape)
+        self._assign_cuts()
         return worst
 
     def motion_twists(self) -> np.ndarray | None:
         """``(E, K, 3)`` twists ``(vx, vy, w)`` of the exact contacts in the last solve's
         impending motion (``-G_i^T y``), zero where the contact takes no part in it; ``None``
         without multipliers."""
-        dual = self._balance.dual_value
-        if dual is None:
+        twists = self._twists()
+        if twists is None:
             return None
-        twists = -np.einsum("exr,xk->ekr", self._wrenches, np.asarray(dual, dtype=float))
         rho = np.array([m.rho for m in self._models])[:, None]
         size = np.hypot(np.hypot(twists[..., 0], twists[..., 1]), rho * twists[..., 2])
         twists[size <= DUAL_RTOL * size.max(initial=0.0)] = 0.0

@@ -35,9 +35,9 @@ from collections.abc import Callable
 
 import cvxpy as cp
 import numpy as np
-import scipy.sparse as sp
 
 from fixplan.models.exact import Exact
+from fixplan.planner.exact_contacts import ExactContacts
 from fixplan.tolerances import (
     EXACT_CUT_RTOL,
     FRICTION_SET_RTOL,
@@ -95,87 +95,38 @@ def smooth(models) -> bool:
     return bool(exact) and not any(m.surface.has_facets for m in exact)
 
 
-class OsculatingPool:
-    """The ellipsoid Parameters of a stacked problem's exact contacts, and their rounds.
+class OsculatingPool(ExactContacts):
+    """The ellipsoid Parameters of a stacked problem's exact contacts, their ``CUT_SLOTS`` cut
+    rows, and their rounds (the other parameters are those of
+    :class:`~fixplan.planner.exact_contacts.ExactContacts`).
 
     Parameters
     ----------
-    models : dict
-        Contact index -> its smooth :class:`~fixplan.models.Exact` model.
-    slices : tuple of slice
-        Rows of each contact's friction load in the stacked friction variable.
-    normal : cvxpy.Expression
-        ``(C, K)`` normal forces [N].
-    friction : cvxpy.Variable
-        ``(D, K)`` friction loads.
-    wrenches : numpy.ndarray
-        ``(6, D)`` body wrench per unit friction load component (the equilibrium's ``G``).
-    balance : cvxpy.Constraint
-        The equilibrium; its multipliers ``(6, K)`` are the impending motion of each case.
     scale : cvxpy.Variable or None
         ``(K,)`` task-load multiples of a fixed-force objective (``None`` for the force
         objectives, whose cases share their optimum).
     """
 
-    def __init__(
-        self,
-        models: dict,
-        slices,
-        normal: cp.Expression,
-        friction: cp.Variable,
-        *,
-        wrenches: np.ndarray,
-        balance: cp.Constraint,
-        scale: cp.Variable | None = None,
-    ):
+    def __init__(self, models: dict, slices, normal, friction, *, wrenches, balance, scale=None):
+        super().__init__(models, slices, normal, friction, wrenches=wrenches, balance=balance,
+                         slots=CUT_SLOTS, name="osculating_cut")  # fmt: skip
         self._scale = scale
-        self._contacts = np.array(sorted(models), dtype=int)
-        self._models = [models[i] for i in self._contacts]
-        self._rows = np.array([np.arange(slices[i].start, slices[i].stop) for i in self._contacts])
-        self._normal, self._friction, self._balance = normal, friction, balance
-        self._wrenches = np.array([wrenches[:, rows] for rows in self._rows])  # (E, 6, 3)
         self._units = np.array([model._units() for model in self._models])  # (E, 3)
         count, cases = len(self._contacts), friction.shape[1]
         self._factors = np.zeros((count, cases, 3, 3))
         self._factors[:, :, [0, 1, 2], [0, 1, 2]] = (1.0 + MARGIN) / self._units[:, None, :]
-        self._planes = np.zeros((3, CUT_SLOTS, count, cases))
         self._next_slot = np.zeros((count, cases), dtype=int)
-        #: ``(C, K)`` friction use ``1 / s`` of every exact contact's load in the last solve the
-        #: rounds checked (NaN for other contacts and unpressed ones).
-        self.use = np.full((normal.shape[0], cases), np.nan)
         self._entries = [(r, c) for r in range(3) for c in range(r, 3)]  # upper triangle
         self._parameters = [
             cp.Parameter((count, cases), name=f"osculating_{r}{c}") for r, c in self._entries
         ]
-        loads = [friction[self._rows[:, c], :] for c in range(3)]
         rows = [0, 0, 0]
         for (r, c), parameter in zip(self._entries, self._parameters, strict=True):
-            rows[r] = rows[r] + cp.multiply(parameter, loads[c])
+            rows[r] = rows[r] + cp.multiply(parameter, friction[self._rows[:, c], :])
         stacked = cp.vstack([cp.vec(row, order="F") for row in rows])
-        forces = normal[self._contacts, :]
-        self._cut_parameters = [
-            cp.Parameter((CUT_SLOTS * count, cases), name=f"osculating_cut_{c}") for c in range(3)
-        ]
-        tile = sp.vstack([sp.eye_array(count)] * CUT_SLOTS, format="csr")
-        cut_rows = sum(
-            cp.multiply(parameter, tile @ loads[c])
-            for c, parameter in enumerate(self._cut_parameters)
-        )
-        self.constraints = [
-            cp.SOC(cp.vec(forces, order="F"), stacked, axis=0),
-            cut_rows <= tile @ forces,
-        ]
+        forces = cp.vec(normal[self._contacts, :], order="F")
+        self.constraints = [cp.SOC(forces, stacked, axis=0), self._cuts]
         self._assign()
-
-    @classmethod
-    def of(
-        cls, models, slices, normal, friction, *, wrenches, balance, scale=None
-    ) -> OsculatingPool | None:
-        """The pool of the exact models among ``models`` (one per contact), or ``None``."""
-        exact = {i: m for i, m in enumerate(models) if isinstance(m, Exact) and not m.frictionless}
-        if not exact:
-            return None
-        return cls(exact, slices, normal, friction, wrenches=wrenches, balance=balance, scale=scale)
 
     @property
     def ellipsoids(self) -> np.ndarray:
@@ -209,7 +160,7 @@ class OsculatingPool:
         friction = np.asarray(self._friction.value, dtype=float)
         forces = normal[self._contacts]  # (E, K)
         loads = np.moveaxis(friction[self._rows], 1, 0)  # (3, E, K)
-        twists = self._twists()  # (E, K, 3), normalised
+        twists = self._twists() * self._units[:, None, :]  # (E, K, 3), normalised
         weights = self._weights(np.linalg.norm(twists, axis=2))
         noise = FRICTION_SET_RTOL * max(float(np.abs(normal).max(initial=0.0)), 1e-300)
         pressed = forces > noise
@@ -287,19 +238,10 @@ class OsculatingPool:
                 self._factors[e, cases[short[usable]]] = found[usable] * (1.0 + MARGIN)
         return not loose.any()
 
-    def _twists(self) -> np.ndarray:
-        """``(E, K, 3)`` normalised twists ``(vx, vy, w) * units`` of the exact contacts in the
-        last solve's impending motion, ``-G_iᵀ y``."""
-        dual = np.asarray(self._balance.dual_value, dtype=float)
-        twists = -np.einsum("exr,xk->ekr", self._wrenches, dual)
-        return twists * self._units[:, None, :]
-
     def _assign(self) -> None:
         for (r, c), parameter in zip(self._entries, self._parameters, strict=True):
             parameter.value = self._factors[:, :, r, c]
-        shape = self._cut_parameters[0].shape
-        for c, parameter in enumerate(self._cut_parameters):
-            parameter.value = self._planes[c].reshape(shape)
+        self._assign_cuts()
 
 
 def _normals(factors: np.ndarray, loads: np.ndarray) -> np.ndarray:
