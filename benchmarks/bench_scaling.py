@@ -22,6 +22,7 @@ import numpy as np
 from fixplan import pressure
 from fixplan.planner.planner import Planner
 from fixplan.planner.problem import Body, Contact, Load, Problem
+from fixplan.planner.stacking import set_units
 
 CONTACTS = (8, 50, 200)
 CASES = (1, 20, 500)
@@ -116,7 +117,7 @@ def dpp_table() -> None:
         times = {}
         for dpp in (True, False):
             stacked = Planner(problem)._runner.stacked(problem.objective)
-            stacked.gravity.value = problem.body.weight_wrench
+            set_units(stacked, problem.body.weight_wrench)
             runs = []
             for seed in range(3):
                 stacked.task.value = np.column_stack([x.wrench for x in milling_loads(cases, seed)])

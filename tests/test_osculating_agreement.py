@@ -31,8 +31,10 @@ MOTION_RTOL = 1e-6
 #: A block of a fixed-force solve with a case held at the cap (``MAX_SAFETY_FACTOR`` = 1e3, an
 #: infinite safety factor) has ``sum(s) ~ 1e3``, and Clarabel's gap tolerance (1e-9 relative)
 #: leaves the other cases' factors about 1e-6 off either way (both ways agree to 1e-9 when the
-#: capped case is solved apart; 2.4e-6 apart in the fixture below).
-CAPPED_BLOCK_ATOL = 4e-6
+#: capped case is solved apart). In the facing-locator fixture below (seed 1), whose forces
+#: found must have safety factor 1, the factors came out 1.4e-6 to 6.3e-6 from 1 with either
+#: method, whatever the force unit of the solves (largest force at 4 to 256 units).
+CAPPED_BLOCK_ATOL = 1e-5
 #: Planar twists ``(vx, vy, wz)`` are compared in these units (rates times 10 mm).
 PLANAR = np.array([1.0, 1.0, 0.01])
 

@@ -22,7 +22,7 @@ import numpy as np
 
 from fixplan.planner.planner import Planner
 from fixplan.planner.problem import SOLVED_AS
-from fixplan.planner.stacking import assign, build, normal_forces, set_given
+from fixplan.planner.stacking import assign, build, normal_forces, set_given, set_units
 
 #: Reweighting rounds.
 RELAXATION_ROUNDS = 4
@@ -44,7 +44,7 @@ def relaxed_forces(planner: Planner, chosen: int) -> np.ndarray | None:
     cases = len(problem.loads)
     stacked = build(problem, planner.layout, objective, cases, squeeze=False)
     assign(stacked.task, problem.task_wrenches())
-    assign(stacked.gravity, problem.body.weight_wrench)
+    set_units(stacked, problem.body.weight_wrench)
     set_given(stacked, {i: c.force for i, c in enumerate(problem.contacts) if c.force is not None},
               cases)  # fmt: skip
     if stacked.sense is not None:

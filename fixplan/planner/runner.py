@@ -7,10 +7,18 @@ solve all cases at once. A compiled problem is re-solved straight through Clarab
 has solved it twice (:mod:`fixplan.planner.direct_solve`): re-solves of a force objective with
 new loads, and the blocks of a fixed-force objective after the second. A solver failure retries
 once with a fallback solver.
+
+Every block is solved in a force unit of its own, a power of two (which divides without
+rounding) that puts its largest force (the components of the task forces, of the task torques
+over the contacts' longest lever, the weight, the given forces) near ``FORCE_IN_UNITS``: the task and gravity wrenches, the
+given forces and the ``max_force`` bounds are divided by it and the answers multiplied back.
+The friction sets are cones, so the program in other units is the same program, but Clarabel's
+answers are not equally good in all of them (its tolerances are partly absolute).
 """
 
 from __future__ import annotations
 
+import math
 import warnings
 
 import cvxpy as cp
@@ -21,12 +29,14 @@ from fixplan.planner.direct_solve import DirectSolver
 from fixplan.planner.osculating import OsculatingPool, smooth
 from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, Problem
 from fixplan.planner.stacking import (
+    REFINE,
     ContactLayout,
     Stacked,
     assign,
     build,
     normal_forces,
     set_given,
+    set_units,
 )
 
 SOLVERS = ("CLARABEL", "OSQP", "SCS")
@@ -47,6 +57,15 @@ DPP_MAX_WORK = 5_000_000
 #: fixture-321 (pyramids) 2,276 / 2,359 / 1,728 / 1,195 cases/s; the ellipsoid fixture (blocks
 #: of 1 / 4 / 8 / 64) 3,021 / 3,930 / 3,615 / 3,102 cases/s.
 CASES_PER_BLOCK = 4
+
+#: The largest force of a block in the units it is solved in (see the module). Measured on the
+#: 6-contact exact fixture of tests/test_exact_planner.py with given clamp forces (max-safety-
+#: factor, largest force 120 N) and on a plate loaded with 7e4 N: with the largest force at 4 to
+#: 1,024 units both are solved right, the first with osculating ellipsoids that settle in 8-9
+#: rounds; at 1 unit or less those rounds stop 1e-7 outside the exact sets and fall back to the
+#: cutting planes, at 4,096 and more too; in newtons (7e4 units) the plate's safety factor came
+#: out 0.966 where 1 holds.
+FORCE_IN_UNITS = 64.0
 
 _FALLBACK = {"CLARABEL": "SCS", "SCS": "CLARABEL", "OSQP": "CLARABEL"}
 #: Clarabel's iterative refinement of the KKT solves is off: it takes about half of the solve
@@ -101,7 +120,12 @@ class Runner:
         self._built: dict[tuple, Stacked] = {}
         self._direct: dict[tuple, DirectSolver | None] = {}
         self._solves: dict[tuple, int] = {}
-        self._given: dict[tuple, tuple | None] = {}  # the given forces last set, if all scalars
+        self._given: dict[tuple, tuple | None] = {}  # (unit, given forces) last set, if scalars
+        self._units: dict[tuple, float] = {}  # the force unit [N] each problem was last set in
+        # Task torques over the longest lever [m] of a contact's normal force are forces.
+        lever = max(float(np.linalg.norm(layout.normal_map[3:], axis=0).max()), 1e-3)
+        self._per_force = np.repeat([1.0, 1.0 / lever], 3)[:, None]  # task wrench -> forces
+        self._weight = float(np.linalg.norm(problem.body.weight_wrench[:3]))
         #: Smooth exact models are first solved with osculating ellipsoids, conic programs that
         #: Clarabel solves (:mod:`fixplan.planner.osculating`); the cutting planes take over
         #: where those rounds do not settle.
@@ -135,7 +159,6 @@ class Runner:
                 self.problem, self._layouts[osculating], objective, self.block_size(objective),
                 squeeze=self.squeeze, switchable=self.switchable,
             )  # fmt: skip
-            assign(stacked.gravity, self.problem.body.weight_wrench)
             self._built[key] = stacked
         return self._built[key]
 
@@ -205,14 +228,16 @@ class Runner:
         """One block (its load cases ``numbers`` among the problem's): with osculating
         ellipsoids first where they apply, else (or where their rounds do not settle) with
         cutting planes or no exact models at all."""
+        unit = self._force_unit(wrenches, given)
         for osculating in (True, False) if self.osculating else (False,):
             key = (objective, osculating)
             stacked = self.stacked(*key)
-            self._set_parameters(key, stacked, wrenches, given, sense, unloaded, disabled)
+            self._set_parameters(key, stacked, wrenches / unit, given, sense, unloaded, disabled,
+                                 unit)  # fmt: skip
             exact = stacked.exact is not None  # rounds follow every solve
             direct = None if accurate or exact else self._direct_result(key, stacked)
             if direct is not None:
-                return direct
+                return _in_newtons(direct, unit, objective)
             if osculating:
                 cases = [(objective, sense, n, wrenches[:, j]) for j, n in enumerate(numbers)]
                 stacked.exact.place([self._start(*case) for case in cases])
@@ -224,14 +249,26 @@ class Runner:
                     continue
                 # Settled: the loads meet the exact problem's optimality conditions, checked
                 # here whatever the solver said of its accuracy.
-                return self._result(stacked, "optimal", self.solver, notes)
+                return _in_newtons(
+                    self._result(stacked, "optimal", self.solver, notes), unit, objective
+                )
             solver = self.solver
             if status in ("solver-error", "inaccurate"):
                 fallback = _FALLBACK[solver]
                 notes.append(f"{solver} returned {status}; retried with {fallback}")
                 solver = fallback
                 status, _ = self._solve(key, stacked, solver, False, notes)
-            return self._result(stacked, status, solver, notes)
+            return _in_newtons(self._result(stacked, status, solver, notes), unit, objective)
+
+    def _force_unit(self, wrenches: np.ndarray, given: dict) -> float:
+        """The force unit [N] of a block with task ``wrenches`` ``(6, K)`` and ``given`` forces:
+        the power of two that puts its largest force nearest ``FORCE_IN_UNITS``; 1 N for none."""
+        # (A list's max: numpy's reductions cost more on the few numbers of a control loop.)
+        largest = max((np.abs(wrenches) * self._per_force).ravel().tolist(), default=0.0)
+        largest = max(largest, self._weight)
+        for value in given.values():  # (plain numbers, or arrays of the cases)
+            largest = max(largest, value if isinstance(value, float) else float(np.max(value)))
+        return 2.0 ** round(math.log2(largest / FORCE_IN_UNITS)) if largest > 0.0 else 1.0
 
     def _start(self, objective, sense, case, wrench: np.ndarray) -> np.ndarray | None:
         """The ellipsoids ``(E, 3, 3)`` a program starts from for ``case`` (see ``__init__``)."""
@@ -250,12 +287,20 @@ class Runner:
             kept = (wrench.copy(), ellipsoids[:, j])
             self._ellipsoids[int(case)] = self._ellipsoids[(objective, sense, int(case))] = kept
 
-    def _set_parameters(self, key, stacked, wrenches, given, sense, unloaded, disabled) -> None:
+    def _set_parameters(
+        self, key, stacked, wrenches, given, sense, unloaded, disabled, unit
+    ) -> None:
+        """Set the task ``wrenches`` (already in the force ``unit``), the ``given`` forces [N]
+        and the rest of ``stacked``'s parameters."""
         assign(stacked.task, wrenches)
+        if self._units.get(key) != unit:
+            set_units(stacked, self.problem.body.weight_wrench, unit)
+            self._units[key] = unit
         scalars = tuple((i, float(v)) for i, v in given.items() if np.ndim(v) == 0)
-        if len(scalars) < len(given) or self._given.get(key) != scalars:
-            set_given(stacked, given, wrenches.shape[1])  # (not again for the same forces)
-            self._given[key] = scalars if len(scalars) == len(given) else None
+        state = (unit, scalars) if len(scalars) == len(given) else None
+        if state is None or self._given.get(key) != state:
+            set_given(stacked, given, wrenches.shape[1], unit)  # (not again for the same forces)
+            self._given[key] = state
         if stacked.sense is not None:
             assign(stacked.sense, float(sense))
         if stacked.unloaded is not None:
@@ -368,6 +413,24 @@ def _linear(model) -> bool:
     """Whether a contact's friction set is polyhedral (its program rows are linear)."""
     terms = model.gauge_terms()
     return model.frictionless or (terms is not None and all(k == "max" for k, _ in terms))
+
+
+def _in_newtons(result: dict, unit: float, objective: str) -> dict:
+    """``result`` of a program solved in the force ``unit`` [N], in newtons.
+
+    The equilibrium multipliers scale as the objective over the wrenches: by ``1 / unit`` for
+    the fixed-force objectives (dimensionless multiples) and the squared forces, not at all for
+    the force objectives linear in the forces."""
+    if unit == 1.0:
+        return result
+    for key in ("normal", "friction"):
+        if result.get(key) is not None:
+            result[key] = result[key] * unit
+    if result.get("dual") is not None:
+        objective = objective.removesuffix(REFINE)
+        if objective in FIXED_FORCE_OBJECTIVES or objective == "min-squared-normal-force":
+            result["dual"] = result["dual"] / unit
+    return result
 
 
 def _values(stacked: Stacked) -> dict:

@@ -177,6 +177,9 @@ class Stacked:
     exact : CutPool or OsculatingPool or None
         The rounds that bring the exact contacts' loads inside their sets: tangent-plane cuts,
         or osculating ellipsoids in an ``osculating`` layout (``None`` without exact models).
+    limits : tuple
+        ``(parameter, forces)`` pairs: the ``max_force`` bounds [N] of the free finger and clamp
+        forces that have one, and the Parameter that states them (see :func:`set_units`).
     disabled : cvxpy.Parameter or None
         ``(C,)``: 1 where a contact is switched off (its normal force held at 0, so its friction
         load too), for layouts that use some of the contacts (``switchable`` in :func:`build`).
@@ -197,6 +200,7 @@ class Stacked:
     balance: cp.Constraint
     decided: np.ndarray
     exact: CutPool | OsculatingPool | None
+    limits: tuple = ()
     disabled: cp.Parameter | None = None
 
 
@@ -285,14 +289,18 @@ def build(
             constraints.append(rows >= 0)
         else:
             constraints.append(soc_columns(rows, size))
+    limits = []
     for key in ("finger", "clamp"):
         bounded = [(k, contacts[i].max_force) for k, i in enumerate(groups[key])
                    if contacts[i].max_force is not None]  # fmt: skip
         if bounded:
-            rows, limits = zip(*bounded, strict=True)
-            limits = np.asarray(limits)
+            rows, forces = zip(*bounded, strict=True)
+            bound = cp.Parameter(len(rows), nonneg=True, name=f"max_{key}_forces")
+            limits.append((bound, np.asarray(forces, dtype=float)))
             variable = pieces[key][list(rows)]
-            constraints.append(variable <= (limits[:, None] if key == "finger" else limits))
+            if key == "finger":
+                bound = cp.reshape(bound, (len(rows), 1), order="F") @ ones
+            constraints.append(variable <= bound)
     if layout.osculating:
         exact = OsculatingPool.of(layout.models, layout.slices, normal, friction,
                                   wrenches=layout.friction_map, balance=balance,
@@ -349,6 +357,7 @@ def build(
         balance=balance,
         decided=decided,
         exact=exact,
+        limits=tuple(limits),
         disabled=disabled,
     )
 
@@ -363,14 +372,23 @@ def normal_forces(stacked: Stacked) -> np.ndarray:
     return normal
 
 
-def set_given(stacked: Stacked, values: dict, cases: int) -> None:
-    """Set the given normal forces [N]: ``values`` maps contact index -> float or ``(cases,)``."""
+def set_units(stacked: Stacked, weight_wrench: np.ndarray, unit: float = 1.0) -> None:
+    """Set the gravity wrench ``(6,)`` [N, N m] and the ``max_force`` bounds, both divided by
+    the force ``unit`` [N] in which the program is solved (see :mod:`fixplan.planner.runner`)."""
+    assign(stacked.gravity, np.asarray(weight_wrench, dtype=float) / unit)
+    for parameter, forces in stacked.limits:
+        assign(parameter, forces / unit)
+
+
+def set_given(stacked: Stacked, values: dict, cases: int, unit: float = 1.0) -> None:
+    """Set the given normal forces [N] in the force ``unit`` [N] of the program: ``values``
+    maps contact index -> float or ``(cases,)``."""
     fingers, clamps = stacked.given_fingers, stacked.given_clamps
     finger_values = None if fingers is None else np.zeros(fingers.shape)
     clamp_values = None if clamps is None else np.zeros(clamps.shape)
     for i, (kind, row) in stacked.given.items():
         # A planned force may come back from the solver as -1e-12 N: given forces are >= 0.
-        value = np.maximum(values[i], 0.0)
+        value = np.maximum(values[i], 0.0) / unit
         if kind == "finger":
             finger_values[row] = np.broadcast_to(value, (cases,))
         else:
