@@ -20,9 +20,10 @@ from __future__ import annotations
 import cvxpy as cp
 import numpy as np
 
+from fixplan.planner.parameters import assign
 from fixplan.planner.planner import Planner
 from fixplan.planner.problem import SOLVED_AS
-from fixplan.planner.stacking import assign, build, normal_forces, set_given, set_units
+from fixplan.planner.stacking import build, normal_forces, set_given, set_units
 
 #: Reweighting rounds.
 RELAXATION_ROUNDS = 4

@@ -37,7 +37,7 @@ import numpy as np
 
 from fixplan.errors import ConvergenceError, InvalidArgumentError
 from fixplan.planner.direct_solve import INFEASIBLE, DirectSolver
-from fixplan.planner.stacking import assign
+from fixplan.planner.parameters import assign
 
 #: A polished solution is accepted when its equilibrium residual, negative normal forces and
 #: closed gaps of lifted contacts are below this fraction of the step's force scale.

@@ -14,6 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fixplan.models.exact import Exact
+from fixplan.planner.parameters import assign
 
 
 class ExactContacts:
@@ -83,7 +84,7 @@ class ExactContacts:
     def _assign_cuts(self) -> None:
         shape = self._cut_parameters[0].shape
         for axis, parameter in enumerate(self._cut_parameters):
-            parameter.value = self._planes[axis].reshape(shape)
+            assign(parameter, self._planes[axis].reshape(shape))
 
     def _twists(self) -> np.ndarray | None:
         """``(E, K, 3)`` twists ``(vx, vy, w)`` of the exact contacts in the last solve's

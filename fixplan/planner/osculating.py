@@ -38,6 +38,7 @@ import numpy as np
 
 from fixplan.models.exact import Exact
 from fixplan.planner.exact_contacts import ExactContacts
+from fixplan.planner.parameters import assign
 from fixplan.tolerances import (
     EXACT_CUT_RTOL,
     FRICTION_SET_RTOL,
@@ -240,7 +241,7 @@ class OsculatingPool(ExactContacts):
 
     def _assign(self) -> None:
         for (r, c), parameter in zip(self._entries, self._parameters, strict=True):
-            parameter.value = self._factors[:, :, r, c]
+            assign(parameter, self._factors[:, :, r, c])
         self._assign_cuts()
 
 

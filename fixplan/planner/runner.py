@@ -27,12 +27,12 @@ import numpy as np
 from fixplan.errors import FixplanError, InvalidArgumentError
 from fixplan.planner.direct_solve import DirectSolver
 from fixplan.planner.osculating import OsculatingPool, smooth
+from fixplan.planner.parameters import assign
 from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, Problem
 from fixplan.planner.stacking import (
     REFINE,
     ContactLayout,
     Stacked,
-    assign,
     build,
     normal_forces,
     set_given,

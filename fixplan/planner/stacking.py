@@ -29,6 +29,7 @@ from fixplan.models.exact import Exact
 from fixplan.planner.cuts import CutPool
 from fixplan.planner.objectives import objective_expression
 from fixplan.planner.osculating import OsculatingPool
+from fixplan.planner.parameters import assign
 from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, PASSIVE_ROLES, Problem
 from fixplan.tolerances import MAX_SAFETY_FACTOR
 
@@ -397,13 +398,3 @@ def set_given(stacked: Stacked, values: dict, cases: int, unit: float = 1.0) -> 
         assign(fingers, finger_values)
     if clamps is not None:
         assign(clamps, clamp_values)
-
-
-def assign(parameter: cp.Parameter, value) -> None:
-    """Set ``parameter`` to ``value`` (broadcast to its shape) without cvxpy's validation,
-    which costs more than a direct re-solve: the planner's values are checked where they come
-    from (loads, given forces >= 0, multiples)."""
-    array = np.asarray(value, dtype=float)
-    if array.shape != parameter.shape:
-        array = np.broadcast_to(array, parameter.shape)
-    parameter.save_value(np.array(array))  # a copy: the caller may change its array
