@@ -20,6 +20,8 @@ resists (:mod:`fixplan.planner.certificate`).
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import time
 import warnings
 from collections.abc import Callable, Sequence
@@ -41,7 +43,7 @@ from fixplan.planner.problem import (
     Problem,
 )
 from fixplan.planner.runner import SOLVERS, Runner
-from fixplan.planner.squeeze import squeezing, unload_squeezes
+from fixplan.planner.squeeze import choose_unloading, squeeze_members, squeezing
 from fixplan.planner.stacking import REFINE, ContactLayout
 from fixplan.planner.verify import Verifier
 from fixplan.tolerances import MULTIPLE_ATOL
@@ -108,6 +110,7 @@ class Planner:
         self._runner = Runner(
             problem, self.layout, solver, squeeze=bool(self.squeeze_contacts), switchable=switchable
         )
+        self._alone: Runner | None = None  # one load case, to rate unloadings (squeezes)
 
     def solve(
         self,
@@ -242,19 +245,57 @@ class Planner:
         passive_map = self.layout.normal_map[:, self._passive]
         unloaded = np.zeros((int(self._passive.sum()), wrenches.shape[1]), dtype=bool)
         passive_names = [c.name for c in self.problem.contacts if c.role in PASSIVE_ROLES]
+        rate = functools.partial(self._trial_scores, objective, wrenches, given,
+                                 options=dict(options, progress=None))  # fmt: skip
         for _ in range(len(passive_names)):
             if result["status"] not in ("optimal", "inaccurate"):
                 break
-            more = unload_squeezes(passive_map, result["normal"][self._passive], self.length_scale)
-            if not more.any():
+            members = squeeze_members(
+                passive_map, result["normal"][self._passive], self.length_scale
+            )
+            if not any(len(m) for m in members):
                 break
-            unloaded |= more
+            unloaded = choose_unloading(members, unloaded, rate)
             result = self._runner.run(objective, wrenches, given, unloaded=unloaded, **options)
         for j, name in enumerate(load.name for load in self.problem.loads):
             found = tuple(n for n, u in zip(passive_names, unloaded[:, j], strict=True) if u)
             if found:
                 squeezed[name] = tuple(dict.fromkeys(squeezed.get(name, ()) + found))
         return result
+
+    def _trial_scores(self, objective, wrenches, given, trial, decided, options) -> np.ndarray:
+        """How well a trial unloading ``trial`` ``(passive, K)`` serves each load case
+        ``decided`` ``(K,)`` on its own (see :func:`~fixplan.planner.squeeze.choose_unloading`):
+        the task-load multiple (sign of ``sense``, larger first) of a fixed-force objective,
+        whose cases are independent; else the objective of the case solved alone (free clamps
+        couple the cases). ``inf`` where not solved or not decided."""
+        scores = np.full(wrenches.shape[1], np.inf)
+        ok = ("optimal", "inaccurate")
+        if objective in FIXED_FORCE_OBJECTIVES:
+            result = self._runner.run(objective, wrenches, given, unloaded=trial, **options)
+            if result["status"] in ok:
+                scores[decided] = -options["sense"] * result["scale"][decided]
+            return scores
+        if self._alone is None:
+            alone = dataclasses.replace(self.problem, loads=self.problem.loads[:1])
+            self._alone = Runner(alone, self.layout, self.solver, squeeze=True,
+                                 switchable=self.switchable)  # fmt: skip
+        numbers = np.arange(wrenches.shape[1]) if options["cases"] is None else options["cases"]
+        roles = {c.name: c.role for c in self.problem.contacts}
+        for j in np.flatnonzero(decided):
+            values = {
+                i: v if np.ndim(v) == 0 else float(np.asarray(v)[j]) for i, v in given.items()
+            }
+            result = self._alone.run(
+                objective, wrenches[:, [j]], values, unloaded=trial[:, [j]], sense=options["sense"],
+                accurate=options["accurate"], disabled=options["disabled"], cases=numbers[[j]],
+            )  # fmt: skip
+            if result["status"] in ok:
+                forces = self._active_forces(result["normal"])
+                scores[j] = objective_value(
+                    objective.removesuffix(REFINE), forces, roles, result["scale"]
+                )
+        return scores
 
     def _refine(self, objective, result, wrenches, given, squeezed, disabled=None) -> dict:
         """Second stage of a force objective whose free clamps couple the load cases.

@@ -10,17 +10,26 @@ which the rigid model does not know.
 Rule: the passive normal forces of every load case are *squeeze-free*: no squeeze fits under
 them (there is no ``s`` with ``0 <= s <= f_p``), i.e. in every squeeze at least one contact carries
 no normal force. It is enforced by unloading: after a solve, the largest squeeze under the
-passive forces of each case is found (a linear program); of its contacts, the one it loads most
-in proportion (``f_i / s_i`` smallest) is held without normal force in that case, and the problem
-is solved again, until no case contains a squeeze.
+passive forces of each case is found (a linear program); one of its contacts is held without
+normal force in that case, and the problem is solved again, until no case contains a squeeze.
+
+Which contact: the squeeze-free problem is not convex (a union over the choices), and the
+solver's answer, one of many optima of the rigid problem, says nothing reliable about it (the
+forces a squeeze loads most in proportion flip with rounding: 426 N or 13,698 N for the same
+fixture). So every member is tried, case by case (:func:`choose_unloading`; the planner rates
+the trials): each load case takes the member that serves it best on its own (the least forces,
+or the largest multiple of a fixed-force objective), ties going to the first contact. With one
+free clamp force coupling the cases this is the least force over all choices; with several it
+is each case's own best, and another combination may need less.
 
 The rule is conservative: it only removes reactions that the rigid model admits, so forces are
 never lower and safety factors never higher than the rigid model's, and it never relies on a
-preload that nothing applies. It is not unique (another unloading order may hold where this one
-does not); the compliant analysis gives the determinate answer.
+preload that nothing applies. The compliant analysis gives the determinate answer.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 from scipy.optimize import linprog
@@ -44,24 +53,54 @@ def squeezing(normal_map: np.ndarray, length_scale: float) -> np.ndarray:
     return found
 
 
-def unload_squeezes(
+def squeeze_members(
     normal_map: np.ndarray, passive_forces: np.ndarray, length_scale: float
-) -> np.ndarray:
-    """Contacts to unload, ``(P, K)`` bool: per load case (columns of ``passive_forces``
-    ``(P, K)`` [N]) the contact of the largest squeeze under the forces that the squeeze loads
-    most in proportion; none where a case holds no squeeze."""
-    unload = np.zeros(passive_forces.shape, dtype=bool)
-    for j, forces in enumerate(passive_forces.T):
+) -> list[np.ndarray]:
+    """The passive contacts (indices into the columns of ``normal_map``) of the largest squeeze
+    under the forces of each load case (columns of ``passive_forces`` ``(P, K)`` [N]), in
+    increasing order; empty where a case holds no squeeze."""
+    members = []
+    for forces in passive_forces.T:
         forces = np.maximum(forces, 0.0)
         largest = forces.max(initial=0.0)
-        if largest == 0.0:
-            continue
-        squeeze = _largest_squeeze(normal_map, forces / largest, length_scale)
-        if squeeze.sum() <= SQUEEZE_RTOL:
-            continue
-        members = np.flatnonzero(squeeze > SQUEEZE_RTOL)
-        unload[members[np.argmin(forces[members] / squeeze[members])], j] = True
-    return unload
+        squeeze = np.zeros(len(forces))
+        if largest > 0.0:
+            squeeze = _largest_squeeze(normal_map, forces / largest, length_scale)
+        members.append(np.flatnonzero(squeeze > SQUEEZE_RTOL) if squeeze.sum() > SQUEEZE_RTOL
+                       else np.zeros(0, dtype=int))  # fmt: skip
+    return members
+
+
+def choose_unloading(
+    members: list[np.ndarray],
+    unloaded: np.ndarray,
+    scores: Callable[[np.ndarray, np.ndarray], np.ndarray],
+) -> np.ndarray:
+    """``unloaded`` ``(P, K)`` with one more contact of each case's squeeze ``members`` (see
+    :func:`squeeze_members`) unloaded: the member whose trial serves its case best.
+
+    ``scores(trial, cases)`` rates a trial unloading ``(P, K)`` for the ``cases`` ``(K,)`` bool
+    that it decides: ``(K,)``, lower is better, ``inf`` where not solved. Trial ``t`` unloads
+    the ``t``-th member of every case; scores within ``SQUEEZE_RTOL`` of a case's best go to
+    its first member, so that the choice does not depend on rounding.
+    """
+    count = max((len(m) for m in members), default=0)
+    trials = []
+    for t in range(count):
+        trial = unloaded.copy()
+        for j, m in enumerate(members):
+            if len(m):
+                trial[m[min(t, len(m) - 1)], j] = True
+        trials.append(trial)
+    if count <= 1:
+        return trials[0] if trials else unloaded.copy()
+    sizes = np.array([len(m) for m in members])
+    table = np.stack([scores(trial, sizes > t) for t, trial in enumerate(trials)])  # (T, K)
+    table[np.arange(count)[:, None] >= sizes[None, :]] = np.inf  # (trials that repeat a member)
+    best = np.min(table, axis=0)
+    slack = SQUEEZE_RTOL * np.maximum(np.abs(np.where(np.isfinite(best), best, 0.0)), 1.0)
+    chosen = np.argmax(table <= (best + slack)[None, :], axis=0)  # first within; 0 if none solved
+    return np.stack(trials)[chosen, :, np.arange(len(members))].T
 
 
 def _largest_squeeze(
