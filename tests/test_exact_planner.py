@@ -100,6 +100,7 @@ def test_a_uniform_disk_pinch_needs_the_closed_form_grip_force(weight, torque):
     plan = Planner(problem).solve()
     expected, _ = least_normal_force(weight / 2.0, torque / 2.0)
     assert plan.status == "optimal"
+    assert plan.solver == "CLARABEL (osculating ellipsoids)"  # (which method answered)
     np.testing.assert_allclose(plan.normal_forces[:, 0], expected, rtol=OPTIMUM_RTOL)
     assert_loads_inside_their_exact_surfaces(problem, plan)
     # The analysis of the forces found: held with safety factor 1.
@@ -296,6 +297,7 @@ def test_rounds_that_do_not_settle_leave_the_problem_to_the_cutting_planes(monke
     assert (problem.objective, False) in planner._runner._built
     expected, _ = least_normal_force(5.0, 0.1)
     assert plan.status == "optimal"
+    assert plan.solver == "CLARABEL (cutting planes)"
     np.testing.assert_allclose(plan.normal_forces[:, 0], expected, rtol=OPTIMUM_RTOL)
 
 
@@ -331,6 +333,7 @@ def test_point_supports_take_the_cutting_planes():
     assert not planner._runner.osculating
     plan = planner.solve()
     assert plan.status == "optimal"
+    assert plan.solver == "CLARABEL (cutting planes)"
     assert_loads_inside_their_exact_surfaces(problem, plan)
 
 

@@ -25,7 +25,7 @@ from fixplan import pressure
 from fixplan.errors import InvalidArgumentError
 from fixplan.io.figures import contact_section_figure, layout_figure, safety_figure
 from fixplan.io.problem_file import load_problem
-from fixplan.io.report import default_sliding_subspace, write_report
+from fixplan.io.report import _solver_text, default_sliding_subspace, write_report
 from fixplan.planner.contact_models import contact_model
 from fixplan.planner.plan import Plan
 from fixplan.planner.planner import Planner
@@ -415,3 +415,21 @@ def test_the_html_page_renders_with_its_figures_in_a_headless_browser(reports, t
     # Text and tables alone give a few hundred coloured pixels (measured: 240 with every image
     # missing); the figures give about 1e5.
     assert coloured.sum() > 10_000
+
+
+@pytest.mark.parametrize(
+    ("solvers", "expected"),
+    [
+        (
+            "CLARABEL (osculating ellipsoids)",
+            f"CLARABEL (osculating ellipsoids) {version('clarabel')}",
+        ),
+        (
+            "dual simplex (direct), CLARABEL",
+            f"dual simplex (direct) {version('fixplan')}, CLARABEL",
+        ),
+    ],
+)
+def test_the_solver_used_names_the_package_behind_each_method(solvers, expected):
+    # A method in parentheses keeps its solver's version; the dual simplex is fixplan's own.
+    assert _solver_text(solvers).startswith(expected)

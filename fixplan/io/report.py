@@ -74,7 +74,8 @@ RESIDUAL_FLOOR = 1e-12
 #: The figure of a compliant analysis (:func:`fixplan.io.figures.utilisation_figure`).
 UTILISATION_FIGURE = "compliant-utilisation.png"
 
-_SOLVER_PACKAGES = {"CLARABEL": "clarabel", "OSQP": "osqp", "SCS": "scs"}
+#: The package behind each solver name (the dual simplex is fixplan's own).
+_SOLVER_PACKAGES = {"CLARABEL": "clarabel", "OSQP": "osqp", "SCS": "scs", "dual simplex": "fixplan"}
 
 
 # -- numbers and names --------------------------------------------------------------------------
@@ -115,7 +116,8 @@ def _package_version(package: str) -> str:
 def _solver_text(solvers: str) -> str:
     names = [s for s in (part.strip() for part in solvers.split(",")) if s]
     return ", ".join(
-        f"{name} {_package_version(_SOLVER_PACKAGES.get(name, name.lower()))}" for name in names
+        f"{name} {_package_version(_SOLVER_PACKAGES.get(base, base.lower()))}"
+        for name, base in ((n, n.split(" (")[0]) for n in names)
     )
 
 

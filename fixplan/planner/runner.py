@@ -249,15 +249,16 @@ class Runner:
                     continue
                 # Settled: the loads meet the exact problem's optimality conditions, checked
                 # here whatever the solver said of its accuracy.
-                return _in_newtons(
-                    self._result(stacked, "optimal", self.solver, notes), unit, objective
-                )
+                solver = f"{self.solver} (osculating ellipsoids)"
+                return _in_newtons(self._result(stacked, "optimal", solver, notes), unit, objective)
             solver = self.solver
             if status in ("solver-error", "inaccurate"):
                 fallback = _FALLBACK[solver]
                 notes.append(f"{solver} returned {status}; retried with {fallback}")
                 solver = fallback
                 status, _ = self._solve(key, stacked, solver, False, notes)
+            if exact:
+                solver = f"{solver} (cutting planes)"
             return _in_newtons(self._result(stacked, status, solver, notes), unit, objective)
 
     def _force_unit(self, wrenches: np.ndarray, given: dict) -> float:
