@@ -17,6 +17,14 @@ The exact model (osculating ellipsoids, :mod:`fixplan.planner.osculating`) is ti
 twentieth of the path, against the ellipsoid's figures of the same run, with the mean number
 of rounds per solve.
 
+The pyramid grasp's linear program (``min q·x``, ``A x = b`` on the equilibrium rows and
+``A x <= b`` on the rest; only ``b`` changes with the loads) is then handed, as the planner
+states it at every step of the path, to three solvers in the same run, each warm from its last
+solve: fixplan's dual simplex (:mod:`fixplan.planner.dual_simplex`), HiGHS through ``highspy``
+(the model passed once, the row bounds changed, its simplex hot-started from the kept basis)
+and Clarabel (``b`` updated in place; an interior point has no warm start). Their optima must
+agree to 1e-6 (relative to the optimum, at least 1).
+
 The machine's load average is printed with the figures (other processes slow these
 single-threaded runs).
 """
@@ -27,13 +35,18 @@ import argparse
 import os
 import time
 
+import clarabel
 import cvxpy as cp
+import highspy
 import numpy as np
+import scipy.sparse as sp
 from bench_planner import fixture
 from performance_rows import emit
 
+from fixplan.planner.dual_simplex import DualSimplex
 from fixplan.planner.planner import Planner
 from fixplan.planner.problem import Load
+from fixplan.planner.runner import _SOLVER_OPTIONS
 
 MODELS = ("ellipsoid", "point-cone", "pyramid")
 
@@ -106,6 +119,114 @@ def main() -> None:
         )
 
     exact_row(path[: max(count // 20, 10)], medians["ellipsoid"])
+    linear_program_row(path)
+
+
+def linear_program_row(path: list) -> None:
+    """The pyramid grasp's linear program at every step of ``path``, solved by the dual
+    simplex, HiGHS and Clarabel, each warm from its last solve (see the module)."""
+    problem = fixture("pyramid", "min-total-clamp-force", path[0])
+    planner = Planner(problem)
+    for warm in path[:3]:
+        planner.solve(warm, analyse=False)
+    direct = planner._runner._direct[(problem.objective, False)]
+    program = direct._program
+    steps = []
+    for load in path:
+        planner.solve(load, analyse=False)  # sets the parameters as the planner states them
+        vector = program.parameter_vector()
+        q, _ = program.cost(vector)
+        a, b = program.constraints(vector)
+        steps.append(b)
+    matrix, equalities = program.dense(a), direct._simplex._equalities
+    solvers = {
+        "dual simplex": _simplex_steps(matrix, q, equalities),
+        "HiGHS (hot start)": _highs_steps(matrix, q, equalities),
+        "Clarabel": _clarabel_steps(matrix, q, equalities),
+    }
+    times, optima = {}, {}
+    for name, step in solvers.items():
+        step(steps[0])  # first solve: cold
+        times[name] = np.empty(len(steps))
+        optima[name] = np.empty(len(steps))
+        for k, b in enumerate(steps):
+            start = time.perf_counter()
+            x = step(b)
+            times[name][k] = time.perf_counter() - start
+            optima[name][k] = q @ x
+    scale = np.maximum(np.abs(optima["Clarabel"]), 1.0)
+    disagreement = {
+        name: float(np.max(np.abs(values - optima["dual simplex"]) / scale))
+        for name, values in optima.items()
+    }
+    assert max(disagreement.values()) <= 1e-6, disagreement
+    ours = np.median(times["dual simplex"])
+    print(f"linear program of the pyramid grasp ({matrix.shape[0]} rows, {matrix.shape[1]} "
+          f"variables), {len(steps):,} right-hand sides; largest relative difference of the "
+          f"optima from the dual simplex's: HiGHS {disagreement['HiGHS (hot start)']:.1e}, "
+          f"Clarabel {disagreement['Clarabel']:.1e}")  # fmt: skip
+    for name, measured in times.items():
+        print(f"  {name:18s} {figures(measured)}; / dual simplex {np.median(measured) / ours:5.1f}")
+    emit(
+        f"the pyramid grasp's linear program alone ({matrix.shape[0]} rows × {matrix.shape[1]} "
+        f"variables), {len(steps):,} right-hand sides (median, p99): fixplan's dual simplex",
+        figures(times["dual simplex"]),
+        "; ".join(f"{name} {figures(times[name])}" for name in ("HiGHS (hot start)", "Clarabel")),
+        "; ".join(f"{np.median(times[name]) / ours:.1f}× slower"
+                  for name in ("HiGHS (hot start)", "Clarabel")),
+    )  # fmt: skip
+
+
+def _simplex_steps(matrix, q, equalities):
+    simplex = DualSimplex(equalities)
+    return lambda b: simplex.solve(matrix, q, b)[0]
+
+
+def _highs_steps(matrix, q, equalities):
+    """HiGHS with the program passed once; each step changes the row bounds to ``b``."""
+    inf = highspy.kHighsInf
+    rows, columns = matrix.shape
+    sparse = sp.csc_array(matrix)
+    lp = highspy.HighsLp()
+    lp.num_col_, lp.num_row_ = columns, rows
+    lp.col_cost_ = q
+    lp.col_lower_, lp.col_upper_ = np.full(columns, -inf), np.full(columns, inf)
+    lp.row_lower_, lp.row_upper_ = np.zeros(rows), np.zeros(rows)
+    lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+    lp.a_matrix_.start_ = sparse.indptr.astype(np.int32)
+    lp.a_matrix_.index_ = sparse.indices.astype(np.int32)
+    lp.a_matrix_.value_ = sparse.data
+    highs = highspy.Highs()
+    highs.setOptionValue("output_flag", False)
+    highs.passModel(lp)
+    index = np.arange(rows, dtype=np.int32)
+    lower = np.full(rows, -inf)
+
+    def step(b):
+        lower[:equalities] = b[:equalities]
+        highs.changeRowsBounds(rows, index, lower, b)
+        highs.run()
+        return np.asarray(highs.getSolution().col_value)
+
+    return step
+
+
+def _clarabel_steps(matrix, q, equalities):
+    """Clarabel with the planner's settings; each step updates ``b`` in place."""
+    options = clarabel.DefaultSettings()
+    options.verbose, options.presolve_enable = False, False
+    for key, value in _SOLVER_OPTIONS["CLARABEL"].items():
+        setattr(options, key, value)
+    rows, columns = matrix.shape
+    cones = [clarabel.ZeroConeT(equalities), clarabel.NonnegativeConeT(rows - equalities)]
+    zero = sp.csc_matrix((columns, columns))
+    solver = clarabel.DefaultSolver(zero, q, sp.csc_matrix(matrix), np.zeros(rows), cones, options)
+
+    def step(b):
+        solver.update(b=b)
+        return np.asarray(solver.solve().x)
+
+    return step
 
 
 def exact_row(path: list, ellipsoid: tuple[float, float]) -> None:
