@@ -63,6 +63,7 @@ class DirectSolver:
             (v.id, offsets[v.id], offsets[v.id] + v.size, v.shape) for v in problem.variables()
         ]
         self._equalities = equalities
+        self._sign = -1.0 if isinstance(problem.objective, cp.Maximize) else 1.0  # of the value
         self.objective_value = float("nan")
         #: Clarabel's status of the last solve.
         self.status = ""
@@ -139,7 +140,7 @@ class DirectSolver:
             x, self._dual = np.asarray(solution.x), np.asarray(solution.z)
             value = float(solution.obj_val)
         value += constant  # of the minimisation cvxpy compiled
-        self.objective_value = -value if isinstance(self._problem.objective, cp.Maximize) else value
+        self.objective_value = self._sign * value
         return {
             key: x[start:stop].reshape(shape, order="F")
             for key, start, stop, shape in self._placement
@@ -226,7 +227,13 @@ class _Program:
         self._columns = [(p, program.param_id_to_col[p.id], p.size) for p in parameters]
         self._size = program.total_param_size + 1  # the last entry is the constant 1
         self._variables = program.x.size
-        self._q = _for_products(sp.csr_array(program.q))
+        q_map = sp.csr_array(program.q)
+        self._q = _for_products(q_map)
+        #: ``(q, constant)`` where the cost does not depend on the parameters, else ``None``.
+        self._fixed_cost = None
+        if q_map[:, : self._size - 1].nnz == 0:
+            full = q_map @ np.r_[np.zeros(self._size - 1), 1.0]
+            self._fixed_cost = (full[: self._variables], float(full[self._variables]))
         program.reduced_A.cache()
         a_map = sp.csr_array(program.reduced_A.reduced_mat)
         indices, indptr, shape = program.reduced_A.problem_data_index
@@ -240,6 +247,11 @@ class _Program:
         self._parametric_entries = np.diff(parametric.tocsr().indptr) > 0
         self.fixed_a = not self._parametric_entries.any()
         self._a_map = _for_products(a_map)
+        #: Where ``A`` is fixed: its values, and the map of ``b`` alone.
+        self._fixed_values = None
+        if self.fixed_a:
+            self._fixed_values = -(a_map[: self._split] @ np.r_[np.zeros(self._size - 1), 1.0])
+            self._b_map = _for_products(a_map[self._split :])
         if program.reduced_P is None or program.reduced_P.matrix_data is None:
             self.quadratic = sp.csc_matrix((self._variables, self._variables))
             self.parametric_p = False
@@ -261,14 +273,19 @@ class _Program:
 
     def cost(self, vector) -> tuple[np.ndarray, float]:
         """``q`` and the constant of the cost."""
+        if self._fixed_cost is not None:
+            return self._fixed_cost
         full = self._q @ vector
         return full[: self._variables], float(full[self._variables])
 
     def constraints(self, vector) -> tuple[np.ndarray, np.ndarray]:
         """Clarabel's ``A`` as its values in the fixed pattern (:meth:`matrix`) and ``b``:
         cvxpy's ``A x + b`` in the cones is ``b_C - A_C x`` with ``A_C = -A``, ``b_C = b``."""
-        values = self._a_map @ vector
         b = np.zeros(self._a_shape[0])
+        if self._fixed_values is not None:
+            b[self._a_rows[self._split :]] = self._b_map @ vector
+            return self._fixed_values, b
+        values = self._a_map @ vector
         b[self._a_rows[self._split :]] = values[self._split :]
         return -values[: self._split], b
 
