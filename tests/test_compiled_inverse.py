@@ -16,7 +16,7 @@ from fixplan.surface.compiled_inverse import compile_kernel, not_converged
 from fixplan.surface.disk_kernel import DiskKernel
 from fixplan.surface.inverse import solve
 from fixplan.surface.kernels import PosedKernel, SumKernel
-from fixplan.surface.limit_surface import LimitSurface
+from fixplan.surface.limit_surface import COMPILED_SUPPORT_MAX_TWISTS, LimitSurface
 from fixplan.surface.point_kernel import PointSetKernel
 
 SAFETY_RTOL = 1e-12  # both run Newton to 1e-12 on the twist: s agrees to about its square
@@ -113,6 +113,20 @@ def test_the_compiled_path_gives_the_answers_of_the_numpy_path(name, how):
         b /= np.linalg.norm(b, axis=1, keepdims=True)
         angle = np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.einsum("ij,ij->i", a, b))
         assert np.max(angle) <= MOTION_RAD, distribution
+
+
+@pytest.mark.parametrize("name", sorted(SURFACES))
+def test_small_batches_of_the_support_function_give_the_numpy_kernels_values(name):
+    # Up to COMPILED_SUPPORT_MAX_TWISTS twists the compiled kernel answers, one at a time.
+    surface = SURFACES[name]()
+    rng = np.random.default_rng(8)
+    rho = surface.characteristic_length
+    twists = rng.normal(size=(COMPILED_SUPPORT_MAX_TWISTS, 3)) * [1, 1, 1 / rho]
+    twists[:3] = [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, -2.0, 0.0]]
+    expected = surface._scale * surface._kernel.support(twists)
+    np.testing.assert_allclose(surface.support(twists), expected, rtol=1e-13)
+    assert surface.support(twists[5]) == pytest.approx(expected[5], rel=1e-13)
+    assert surface.support([0.0, 0.0, 0.0]) == 0.0  # (the NumPy disk kernels give NaN there)
 
 
 def test_zero_loads_in_a_batch_are_held_with_no_motion():

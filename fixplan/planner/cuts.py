@@ -75,9 +75,9 @@ class CutPool(ExactContacts):
     (``CUT_SLOTS`` per contact and load case; the other parameters are those of
     :class:`~fixplan.planner.exact_contacts.ExactContacts`)."""
 
-    def __init__(self, models: dict, slices, normal, friction, *, wrenches, balance):
-        super().__init__(models, slices, normal, friction, wrenches=wrenches, balance=balance,
-                         slots=CUT_SLOTS, name="cut")  # fmt: skip
+    def __init__(self, models: dict, slices, normal, friction, *, normal_parts, wrenches, balance):
+        super().__init__(models, slices, normal, friction, normal_parts=normal_parts,
+                         wrenches=wrenches, balance=balance, slots=CUT_SLOTS, name="cut")  # fmt: skip
         self._used = np.full((CUT_SLOTS, len(self._contacts), friction.shape[1]), -1, np.int64)
         self._round = 0
         self.constraints = [self._cuts]
@@ -105,7 +105,7 @@ class CutPool(ExactContacts):
         Returns the largest relative excess ``1 / s - 1`` of a pressed contact's load (before
         the new cuts; negative when all are inside).
         """
-        normal = np.asarray(self._normal.value, dtype=float)
+        normal = self._normal_values()
         friction = np.asarray(self._friction.value, dtype=float)
         forces = normal[self._contacts]  # (E, K)
         loads = np.moveaxis(friction[self._rows], 1, 0)  # (3, E, K)

@@ -14,7 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from fixplan.models.exact import Exact
-from fixplan.planner.parameters import assign
+from fixplan.planner.parameters import assign, part_values
 
 
 class ExactContacts:
@@ -28,6 +28,9 @@ class ExactContacts:
         Rows of each contact's friction load in the stacked friction variable.
     normal : cvxpy.Expression
         ``(C, K)`` normal forces [N].
+    normal_parts : tuple
+        The ``(contact indices, variable or parameter)`` pairs that make up ``normal`` (see
+        :class:`~fixplan.planner.stacking.Stacked`), whose values are read after a solve.
     friction : cvxpy.Variable
         ``(D, K)`` friction loads.
     wrenches : numpy.ndarray
@@ -47,6 +50,7 @@ class ExactContacts:
         normal: cp.Expression,
         friction: cp.Variable,
         *,
+        normal_parts: tuple,
         wrenches: np.ndarray,
         balance: cp.Constraint,
         slots: int,
@@ -56,6 +60,7 @@ class ExactContacts:
         self._models = [models[i] for i in self._contacts]
         self._rows = np.array([np.arange(slices[i].start, slices[i].stop) for i in self._contacts])
         self._normal, self._friction, self._balance = normal, friction, balance
+        self._normal_parts = normal_parts
         self._wrenches = np.array([wrenches[:, rows] for rows in self._rows])  # (E, 6, 3)
         count, cases = len(self._contacts), friction.shape[1]
         #: ``(C, K)`` friction use ``1 / s`` of every exact contact's load in the last solve the
@@ -80,6 +85,10 @@ class ExactContacts:
         """The pool of the exact models among ``models`` (one per contact), or ``None``."""
         exact = {i: m for i, m in enumerate(models) if isinstance(m, Exact) and not m.frictionless}
         return cls(exact, slices, normal, friction, **options) if exact else None
+
+    def _normal_values(self) -> np.ndarray:
+        """``(C, K)`` normal forces [N] of the last solve."""
+        return part_values(self._normal_parts, self._normal.shape)
 
     def _assign_cuts(self) -> None:
         shape = self._cut_parameters[0].shape

@@ -108,9 +108,13 @@ class OsculatingPool(ExactContacts):
         objectives, whose cases share their optimum).
     """
 
-    def __init__(self, models: dict, slices, normal, friction, *, wrenches, balance, scale=None):
-        super().__init__(models, slices, normal, friction, wrenches=wrenches, balance=balance,
-                         slots=CUT_SLOTS, name="osculating_cut")  # fmt: skip
+    def __init__(
+        self, models: dict, slices, normal, friction, *, normal_parts, wrenches, balance,
+        scale=None,
+    ):  # fmt: skip
+        super().__init__(models, slices, normal, friction, normal_parts=normal_parts,
+                         wrenches=wrenches, balance=balance, slots=CUT_SLOTS,
+                         name="osculating_cut")  # fmt: skip
         self._scale = scale
         self._units = np.array([model._units() for model in self._models])  # (E, 3)
         count, cases = len(self._contacts), friction.shape[1]
@@ -157,7 +161,7 @@ class OsculatingPool(ExactContacts):
     def move(self) -> bool:
         """Put each ellipsoid where its contact's solved load meets the exact set; whether the
         solve already met the exact problem's optimality conditions (see the module)."""
-        normal = np.asarray(self._normal.value, dtype=float)
+        normal = self._normal_values()
         friction = np.asarray(self._friction.value, dtype=float)
         forces = normal[self._contacts]  # (E, K)
         loads = np.moveaxis(friction[self._rows], 1, 0)  # (3, E, K)
@@ -226,9 +230,7 @@ class OsculatingPool(ExactContacts):
             rows = np.flatnonzero(owner == e)
             model = self._models[e]
             twist = twists[e, cases[rows]] / self._units[e]  # load-space twists
-            factors = self._factors[e, cases[rows]]
-            inverse = np.linalg.solve(factors.transpose(0, 2, 1), twist[:, :, None])
-            reach = np.linalg.norm(inverse[:, :, 0], axis=1)  # ellipsoid support ‖R⁻ᵀ V‖
+            reach = _support(self._factors[e, cases[rows]], twist)
             exact = model.surface.support(twist) / model.surface.normal_force
             loose[rows] = weights[e, cases[rows]] * (1.0 - reach / exact) > SUPPORT_RTOL
             if loose[rows].any():
@@ -243,6 +245,16 @@ class OsculatingPool(ExactContacts):
         for (r, c), parameter in zip(self._entries, self._parameters, strict=True):
             assign(parameter, self._factors[:, :, r, c])
         self._assign_cuts()
+
+
+def _support(factors: np.ndarray, twists: np.ndarray) -> np.ndarray:
+    """Support ``‖R⁻ᵀ V‖`` ``(K,)`` of the ellipsoids ``‖R q‖ <= 1`` (``factors`` ``(K, 3, 3)``
+    upper triangular) at the twists ``V`` ``(K, 3)``: ``Rᵀ y = V`` by forward substitution."""
+    r, v = factors, twists
+    y0 = v[:, 0] / r[:, 0, 0]
+    y1 = (v[:, 1] - r[:, 0, 1] * y0) / r[:, 1, 1]
+    y2 = (v[:, 2] - r[:, 0, 2] * y0 - r[:, 1, 2] * y1) / r[:, 2, 2]
+    return np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
 
 
 def _normals(factors: np.ndarray, loads: np.ndarray) -> np.ndarray:

@@ -29,7 +29,7 @@ from fixplan.models.exact import Exact
 from fixplan.planner.cuts import CutPool
 from fixplan.planner.objectives import objective_expression
 from fixplan.planner.osculating import OsculatingPool
-from fixplan.planner.parameters import assign
+from fixplan.planner.parameters import assign, part_values
 from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, PASSIVE_ROLES, Problem
 from fixplan.tolerances import MAX_SAFETY_FACTOR
 
@@ -304,11 +304,12 @@ def build(
             constraints.append(variable <= bound)
     if layout.osculating:
         exact = OsculatingPool.of(layout.models, layout.slices, normal, friction,
-                                  wrenches=layout.friction_map, balance=balance,
-                                  scale=scale if scaling else None)  # fmt: skip
+                                  normal_parts=tuple(normal_parts), wrenches=layout.friction_map,
+                                  balance=balance, scale=scale if scaling else None)  # fmt: skip
     else:
         exact = CutPool.of(layout.models, layout.slices, normal, friction,
-                           wrenches=layout.friction_map, balance=balance)  # fmt: skip
+                           normal_parts=tuple(normal_parts), wrenches=layout.friction_map,
+                           balance=balance)  # fmt: skip
     if exact is not None:
         constraints += exact.constraints
     unloaded = None
@@ -365,12 +366,7 @@ def build(
 
 def normal_forces(stacked: Stacked) -> np.ndarray:
     """The normal forces ``(C, K)`` [N] of the last solve, from the values of their parts."""
-    cases = stacked.task.shape[1]
-    normal = np.zeros((len(stacked.decided), cases))
-    for index, piece in stacked.normal_parts:
-        values = np.asarray(piece.value, dtype=float)
-        normal[index] = values if values.ndim == 2 else values[:, None]
-    return normal
+    return part_values(stacked.normal_parts, (len(stacked.decided), stacked.task.shape[1]))
 
 
 def set_units(stacked: Stacked, weight_wrench: np.ndarray, unit: float = 1.0) -> None:

@@ -464,6 +464,19 @@ def _solve(
         out_safety[k] = safety / size
 
 
+def _supports(kernel, twists, out):  # pragma: no cover - compiled
+    """Support values ``out`` ``(K,)`` of the unit-friction ``kernel`` at ``twists`` ``(K, 3)``
+    (0 at a zero twist)."""
+    local = np.empty(10)
+    terms = np.empty(10)
+    for k in range(twists.shape[0]):
+        if twists[k, 0] == 0.0 and twists[k, 1] == 0.0 and twists[k, 2] == 0.0:
+            out[k] = 0.0
+            continue
+        _terms(kernel, 0.0, twists[k], False, local, terms)
+        out[k] = terms[0]
+
+
 def _hessians(kernel, twists, out):  # pragma: no cover - compiled
     """Support Hessians ``out`` ``(K, 3, 3)`` of the unit-friction ``kernel`` at ``twists``."""
     local = np.empty(10)
@@ -476,6 +489,7 @@ def _hessians(kernel, twists, out):  # pragma: no cover - compiled
 _terms = compiled_scalar(_terms)
 _unpack = compiled_scalar(_unpack)
 _hessians = compiled_scalar(_hessians)
+_supports = compiled_scalar(_supports)
 _projected = compiled_scalar(_projected)
 _newton_step = compiled_scalar(_newton_step)
 _newton = compiled_scalar(_newton)
@@ -524,6 +538,12 @@ class CompiledKernel:
         if gradient[worst] > INVERSE_GRADIENT_RTOL:
             raise not_converged(loads[worst], float(gradient[worst]))
         return safety, twist
+
+    def supports(self, twists: np.ndarray) -> np.ndarray:
+        """Values ``(K,)`` of the unit-friction support at ``twists`` ``(K, 3)``."""
+        out = np.empty(len(twists))
+        _supports(self.parts, np.ascontiguousarray(twists, dtype=float), out)
+        return out
 
     def hessians(self, twists: np.ndarray) -> np.ndarray:
         """Hessians ``(K, 3, 3)`` of the unit-friction support at nonzero ``twists`` ``(K, 3)``."""
