@@ -115,7 +115,8 @@ class Exact(FrictionModel):
         Parameters
         ----------
         loads : numpy.ndarray
-            ``(K, 3)`` loads ``(fx, fy, m)`` per unit normal force [-, -, m], nonzero.
+            ``(K, 3)`` loads ``(fx, fy, m)`` per unit normal force [-, -, m], nonzero and
+            finite (not checked: the planner's loads, many times per solve).
 
         Returns
         -------
@@ -134,8 +135,7 @@ class Exact(FrictionModel):
         support is read from the inverse map's answer instead of being integrated again
         (relative difference about 1e-14, far below the planner's ``CUT_MARGIN``).
         """
-        twists, safety = self.surface.motion_and_safety_factor(loads * self.surface.normal_force)
-        twists, safety = np.atleast_2d(twists), np.atleast_1d(safety)
+        safety, twists = self.surface._trusted_inverse(loads * self.surface.normal_force)
         support = safety * np.einsum("ij,ij->i", loads, twists)
         return twists / support[:, None], 1.0 / safety - 1.0
 
@@ -145,7 +145,8 @@ class Exact(FrictionModel):
         Parameters
         ----------
         loads : numpy.ndarray
-            ``(K, 3)`` loads ``(fx, fy, m)`` per unit normal force [-, -, m], nonzero.
+            ``(K, 3)`` loads ``(fx, fy, m)`` per unit normal force [-, -, m], nonzero and
+            finite (not checked).
 
         Returns
         -------
@@ -171,7 +172,7 @@ class Exact(FrictionModel):
         units = self._units()
         points = loads / (1.0 + excess)[:, None]
         a, u = planes * units, points / units  # normalised plane and point, a · u = 1
-        curvature = self.surface.support_hessian(planes) / self.surface.normal_force
+        curvature = self.surface._trusted_hessians(planes) / self.surface.normal_force
         curvature /= units[None, :, None] * units[None, None, :]
         factors = np.empty((len(loads), 3, 3))
         _OSCULATING_FACTORS(a, u, curvature, factors)

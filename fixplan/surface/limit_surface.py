@@ -291,6 +291,23 @@ class LimitSurface:
             twists[rows] = result.twist
         return safety, twists, single
 
+    def _trusted_inverse(self, loads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Safety factors ``(K,)`` and sliding twists ``(K, 3)`` (SI, of any size) of nonzero
+        finite loads ``(K, 3)`` [N, N m] from a caller that checked them (the planner's exact
+        models, many times per solve): :meth:`motion_and_safety_factor` without the checks and
+        the twists' normalisation, which cost more than the compiled solve itself."""
+        if self._compiled is not None and self._shape is None:
+            return self._compiled.solve(loads, self._units, self._scale)
+        safety, twists, _ = self._inverse(loads)
+        return safety, twists
+
+    def _trusted_hessians(self, twists: np.ndarray) -> np.ndarray:
+        """:meth:`support_hessian` ``(K, 3, 3)`` of nonzero finite twists ``(K, 3)`` from a
+        caller that checked them (see :meth:`_trusted_inverse`)."""
+        if self._compiled is not None:
+            return self._scale * self._compiled.hessians(twists)
+        return self.support_hessian(twists)
+
     def safety_factor(self, load) -> np.ndarray | float:
         """Factor ``s`` with ``s * load`` on the surface (``inf`` for the zero load).
 
