@@ -271,16 +271,30 @@ class Planner:
         couple the cases). ``inf`` where not solved or not decided."""
         scores = np.full(wrenches.shape[1], np.inf)
         ok = ("optimal", "inaccurate")
+        numbers = np.arange(wrenches.shape[1]) if options["cases"] is None else options["cases"]
         if objective in FIXED_FORCE_OBJECTIVES:
             result = self._runner.run(objective, wrenches, given, unloaded=trial, **options)
             if result["status"] in ok:
                 scores[decided] = -options["sense"] * result["scale"][decided]
+                return scores
+            if wrenches.shape[1] == 1:
+                return scores
+            # A run's status is its worst block's: one case that the trial leaves unheld (given
+            # forces that vary by case) would rule the trial out for every case. Rate the
+            # decided cases one by one.
+            for j in np.flatnonzero(decided):
+                values = {i: v if np.ndim(v) == 0 else np.asarray(v)[[j]] for i, v in given.items()}
+                one = self._runner.run(
+                    objective, wrenches[:, [j]], values, unloaded=trial[:, [j]],
+                    **dict(options, cases=np.asarray(numbers)[[j]]),
+                )  # fmt: skip
+                if one["status"] in ok:
+                    scores[j] = -options["sense"] * one["scale"][0]
             return scores
         if self._alone is None:
             alone = dataclasses.replace(self.problem, loads=self.problem.loads[:1])
             self._alone = Runner(alone, self.layout, self.solver, squeeze=True,
                                  switchable=self.switchable)  # fmt: skip
-        numbers = np.arange(wrenches.shape[1]) if options["cases"] is None else options["cases"]
         roles = {c.name: c.role for c in self.problem.contacts}
         for j in np.flatnonzero(decided):
             values = {
