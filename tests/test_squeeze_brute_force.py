@@ -203,3 +203,11 @@ def test_a_trial_that_one_case_cannot_hold_is_not_ruled_out_for_the_others():
                 highs.append(interval[1])
         assert len(highs) == 1  # each case is held without one locator only
         assert plan.safety_factors[load.name] == pytest.approx(highs[0], rel=AGREEMENT_RTOL)
+
+
+@pytest.mark.parametrize("seed", [2, 7])
+def test_two_independent_squeezes_are_both_unloaded_at_their_best(seed):
+    # The largest squeeze of a case joins both pairs. Rated as they stand, the unloadings of
+    # one pair leave the other squeezing (and carrying the case): every one of them tied, and
+    # the first (side-left) was taken; 59.2 N instead of 37.8 N (seed 2), 63.5 N instead of 0.
+    assert_least_clamp_force(plate(seed, layout="two-pairs"))
