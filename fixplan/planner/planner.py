@@ -97,6 +97,7 @@ class Planner:
         self._friction_component = np.concatenate(
             [np.arange(1, 1 + part.stop - part.start) for part in self.layout.slices]
         ).astype(np.intp)
+        self._passive_map = self.layout.normal_map[:, self._passive]
         self._staying = StayingInContact(self.layout.normal_map, self._passive, self.length_scale)
         self._verify = Verifier(problem, self.layout, self.friction_use, self.length_scale)
         passive_map = self.layout.normal_map[:, self._passive]
@@ -246,7 +247,7 @@ class Planner:
         unloaded = np.zeros((int(self._passive.sum()), wrenches.shape[1]), dtype=bool)
         passive_names = [c.name for c in self.problem.contacts if c.role in PASSIVE_ROLES]
         rate = functools.partial(self._trial_scores, objective, wrenches, given,
-                                 options=dict(options, progress=None))  # fmt: skip
+                                 options=dict(options, progress=None), memo={})  # fmt: skip
         for _ in range(len(passive_names)):
             if result["status"] not in ("optimal", "inaccurate"):
                 break
@@ -263,39 +264,85 @@ class Planner:
                 squeezed[name] = tuple(dict.fromkeys(squeezed.get(name, ()) + found))
         return result
 
-    def _trial_scores(self, objective, wrenches, given, trial, decided, options) -> np.ndarray:
+    def _trial_scores(
+        self, objective, wrenches, given, trial, decided, options, memo
+    ) -> np.ndarray:
         """How well a trial unloading ``trial`` ``(passive, K)`` serves each load case
         ``decided`` ``(K,)`` on its own (see :func:`~fixplan.planner.squeeze.choose_unloading`):
         the task-load multiple (sign of ``sense``, larger first) of a fixed-force objective,
         whose cases are independent; else the objective of the case solved alone (free clamps
-        couple the cases). ``inf`` where not solved or not decided."""
+        couple the cases). ``inf`` where not solved or not decided.
+
+        A case whose answer under the trial still holds a squeeze (the largest squeeze of a
+        case can join several independent ones: two opposing pairs) is rated by the best of
+        its squeeze-free completions (:meth:`_case_best`): rated as it stands, the other
+        squeeze would still carry it, and every member would tie. ``memo`` keeps the ratings
+        of (case, unloading) of one squeeze-free solve."""
         scores = np.full(wrenches.shape[1], np.inf)
-        ok = ("optimal", "inaccurate")
-        if objective in FIXED_FORCE_OBJECTIVES:
-            result = self._runner.run(objective, wrenches, given, unloaded=trial, **options)
-            if result["status"] in ok:
-                scores[decided] = -options["sense"] * result["scale"][decided]
-            return scores
-        if self._alone is None:
-            alone = dataclasses.replace(self.problem, loads=self.problem.loads[:1])
-            self._alone = Runner(alone, self.layout, self.solver, squeeze=True,
-                                 switchable=self.switchable)  # fmt: skip
         numbers = np.arange(wrenches.shape[1]) if options["cases"] is None else options["cases"]
-        roles = {c.name: c.role for c in self.problem.contacts}
-        for j in np.flatnonzero(decided):
+        rest = decided.copy()
+        if objective in FIXED_FORCE_OBJECTIVES:
+            # Cases are independent: one run for all, and alone only the cases it does not
+            # settle (still squeezed, or lost with the run: its status is its worst block's).
+            result = self._runner.run(objective, wrenches, given, unloaded=trial, **options)
+            if result["status"] in ("optimal", "inaccurate"):
+                passive = result["normal"][self._passive]
+                members = squeeze_members(self._passive_map, passive, self.length_scale)
+                for j in np.flatnonzero(decided):
+                    if not len(members[j]):
+                        scores[j] = -options["sense"] * result["scale"][j]
+                        rest[j] = False
+        for j in np.flatnonzero(rest):
             values = {
                 i: v if np.ndim(v) == 0 else float(np.asarray(v)[j]) for i, v in given.items()
             }
-            result = self._alone.run(
-                objective, wrenches[:, [j]], values, unloaded=trial[:, [j]], sense=options["sense"],
-                accurate=options["accurate"], disabled=options["disabled"], cases=numbers[[j]],
+            scores[j] = self._case_best(
+                objective, wrenches[:, [j]], values, trial[:, j].copy(), int(numbers[j]), options,
+                memo,
             )  # fmt: skip
-            if result["status"] in ok:
-                forces = self._active_forces(result["normal"])
-                scores[j] = objective_value(
-                    objective.removesuffix(REFINE), forces, roles, result["scale"]
-                )
         return scores
+
+    def _case_best(self, objective, wrench, values, column, number, options, memo) -> float:
+        """The best rating (lower is better) of load case ``number`` solved alone (task
+        ``wrench`` ``(6, 1)``, given forces ``values``) over the squeeze-free completions of
+        the unloading ``column`` ``(passive,)``: where its answer holds a squeeze, each
+        member is unloaded in turn."""
+        key = (number, column.tobytes())
+        if key in memo:
+            return memo[key]
+        memo[key] = np.inf  # (an unloading is only ever extended)
+        ok = ("optimal", "inaccurate")
+        run = {"sense": options["sense"], "accurate": options["accurate"],
+               "disabled": options["disabled"], "cases": np.array([number])}  # fmt: skip
+        if objective in FIXED_FORCE_OBJECTIVES:
+            runner = self._runner
+        else:
+            if self._alone is None:
+                alone = dataclasses.replace(self.problem, loads=self.problem.loads[:1])
+                self._alone = Runner(alone, self.layout, self.solver, squeeze=True,
+                                     switchable=self.switchable)  # fmt: skip
+            runner = self._alone
+        result = runner.run(objective, wrench, values, unloaded=column[:, None], **run)
+        best = np.inf
+        if result["status"] in ok:
+            passive = result["normal"][self._passive]
+            members = squeeze_members(self._passive_map, passive, self.length_scale)[0]
+            if not len(members):
+                if objective in FIXED_FORCE_OBJECTIVES:
+                    best = -options["sense"] * float(result["scale"][0])
+                else:
+                    roles = {c.name: c.role for c in self.problem.contacts}
+                    forces = self._active_forces(result["normal"])
+                    best = objective_value(
+                        objective.removesuffix(REFINE), forces, roles, result["scale"]
+                    )
+            for member in members:
+                more = column.copy()
+                more[member] = True
+                best = min(best, self._case_best(objective, wrench, values, more, number,
+                                                 options, memo))  # fmt: skip
+        memo[key] = best
+        return best
 
     def _refine(self, objective, result, wrenches, given, squeezed, disabled=None) -> dict:
         """Second stage of a force objective whose free clamps couple the load cases.

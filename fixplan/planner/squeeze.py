@@ -18,8 +18,10 @@ solver's answer, one of many optima of the rigid problem, says nothing reliable 
 forces a squeeze loads most in proportion flip with rounding: 426 N or 13,698 N for the same
 fixture). So every member is tried, case by case (:func:`choose_unloading`; the planner rates
 the trials): each load case takes the member that serves it best on its own (the least forces,
-or the largest multiple of a fixed-force objective), ties going to the first contact. With one
-free clamp force coupling the cases this is the least force over all choices; with several it
+or the largest multiple of a fixed-force objective), ties going to the first contact. A trial
+is rated squeeze-free: where the case still holds a squeeze under it (the largest squeeze can
+join independent ones), by its best completion. With one free clamp force coupling the cases,
+and more clamp force losing no case, this is the least force over all choices; with several it
 is each case's own best, and another combination may need less.
 
 The rule is conservative: it only removes reactions that the rigid model admits, so forces are
