@@ -146,3 +146,66 @@ def test_the_force_unit_is_the_power_of_two_that_brings_the_largest_force_near_i
         assert unit == 1.0
     else:
         assert FORCE_IN_UNITS / np.sqrt(2) <= largest / unit <= FORCE_IN_UNITS * np.sqrt(2)
+
+
+def wedged_plate() -> Problem:
+    """A random fixture of the squeeze review (ellipsoid disks of 5 mm, mu as drawn, one side
+    locator, the top clamp at 0 N) whose second load lifts the plate: held at every multiple by
+    friction at the side and back locators, with a margin of 1.3e-4 in mu (measured by
+    bisection against the reference), while the other two loads press it down."""
+    placed = [
+        ("pad-0", "support", [-0.03565170641423568, -0.03438353343927993, 0.0], [0, 0, 1],
+         0.8997417506587491),
+        ("pad-1", "support", [0.03165449835996233, -0.0206045736141428, 0.0], [0, 0, 1],
+         0.9534887936829477),
+        ("pad-2", "support", [0.0012785349073590416, 0.04288641924302493, 0.0], [0, 0, 1],
+         0.12286352923447935),
+        ("side-left", "locator", [-0.06, 0.0030748585401043638, 0.019260829091898083],
+         [1, 0, 0], 0.7642347266792089),
+        ("back", "locator", [-0.01510392040608572, -0.05, 0.02], [0, 1, 0], 0.6626688764401196),
+        ("clamp-top", "clamp", [-0.0012363464299029949, -0.011870213407558144, 0.04],
+         [0, 0, -1], 0.6738617691217591),
+    ]  # fmt: skip
+    loads = [
+        ([-44.84749301617592, 15.139933321973132, 34.45101728233159],
+         [-0.029555937640526418, 0.025262629632862486, -0.02216212935521631],
+         [-0.24858785455429078, 0.1013970937698132, 0.21651088764364257]),
+        ([5.931433061174687, -13.473614806525575, 45.6379460602727],
+         [-0.006202643962148202, 0.022410939494303846, -0.010206997656316441],
+         [0.25143904673710815, 0.6996356438783746, -0.7603447419876843]),
+        ([-39.49224030181236, 27.391620328854316, -44.918253073274144],
+         [-0.028978159224760595, -0.018560510735780966, -0.006315299783890248],
+         [0.40530446561671796, 0.4004641134205731, -0.5715156703411741]),
+    ]  # fmt: skip
+    patch = pressure.disk(0.004996528846087864)
+    contacts = [
+        Contact(name=n, role=r, position=p, normal=d, mu=mu, model="ellipsoid", patch=patch,
+                force=0.0 if r == "clamp" else None)
+        for n, r, p, d, mu in placed
+    ]  # fmt: skip
+    return Problem(
+        body=Body(mass=1.0612625486423115, center_of_mass=[0.0, 0.0, 0.02]),
+        contacts=contacts,
+        loads=[Load(name=f"L{k}", force=f, point=p, torque=t) for k, (f, p, t) in enumerate(loads)],
+        objective="max-safety-factor",
+    )
+
+
+def test_a_case_is_not_blurred_by_block_mates_at_the_safety_factor_cap():
+    # The three cases share a block; the first and the last are held at every multiple, so the
+    # solve carries them at the cap (1e3 times their loads), and the middle one came out held
+    # only to 0.497 ("optimal"): the tolerances, relative to the largest terms, swallowed its
+    # thin margin. Solved again without them it is held at every multiple, as the reference
+    # (one cvxpy constraint per contact, k uncapped) and the case alone say.
+    import reference_planner as ref
+
+    problem = wedged_plate()
+    plan = Planner(problem).solve()
+    assert plan.status == "optimal"
+    for j, load in enumerate(problem.loads):
+        low, high = ref.held_interval(problem, j, None)
+        assert high >= 1e3  # the reference: held beyond the cap
+        assert plan.safety_factors[load.name] == np.inf
+        assert plan.held_intervals[load.name][0] == pytest.approx(low, abs=1e-7)
+    alone = dataclasses.replace(problem, loads=[problem.loads[1]])
+    assert Planner(alone).solve().safety_factors["L1"] == np.inf

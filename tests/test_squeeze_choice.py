@@ -100,6 +100,10 @@ def test_each_case_unloads_the_side_locator_that_serves_it_best(case_least_force
     # The rule holds: in every case one side locator carries nothing (solver noise aside).
     sides = plan.normal_forces[[3, 4]]
     assert np.all(sides.min(axis=0) <= 1e-6 * np.abs(plan.normal_forces).max(axis=0))
+    # The note names, per case, the side that carries nothing (and only that one).
+    (note,) = [w for w in plan.warnings if "squeeze" in w]
+    for load, side in zip(problem.loads, np.argmin(sides, axis=0), strict=True):
+        assert f"{load.name!r}: {SIDES[side]};" in note or f"{load.name!r}: {SIDES[side]}." in note
     # The choices differ between cases: a single unloaded side for all of them costs more.
     worst_single = min(
         max(per_side[side] if per_side[side] is not None else np.inf

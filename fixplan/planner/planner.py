@@ -366,14 +366,17 @@ class Planner:
     def _intervals(self, highest, wrenches, given, squeezed, progress, disabled=None) -> dict:
         """Held intervals, motions and utilisation of the given forces (``highest``: the
         maximising fixed-force solve)."""
-        lowest = self._lowest(wrenches, given, squeezed, progress, disabled)
+        lowest = self._lowest(wrenches, given, progress, disabled)
         if lowest["status"] not in ("optimal", "inaccurate"):
             lowest = None
         return analyse_cases(self.problem, self.friction_use, self._staying, highest, lowest,
                              wrenches, self.length_scale)  # fmt: skip
 
-    def _lowest(self, wrenches, given, squeezed, progress, disabled=None) -> dict:
+    def _lowest(self, wrenches, given, progress, disabled=None) -> dict:
         """The minimising fixed-force solve: ``scale`` holds ``k_min`` of every case.
+
+        (Its unloaded squeezes stay out of the plan's notes: near ``k = 0`` every choice ties,
+        and the notes name the unloadings behind the forces and safety factors reported.)
 
         At ``k = 0`` the task load drops out, so whether a case is held without it depends only
         on its given forces: one case per distinct column of given forces is solved first, and
@@ -384,7 +387,7 @@ class Planner:
         def minimised(index, report=None):
             values = {i: v if np.ndim(v) == 0 else np.asarray(v)[index] for i, v in given.items()}
             return self._squeeze_free(
-                "check", wrenches[:, index], values, squeezed, sense=-1.0, progress=report,
+                "check", wrenches[:, index], values, {}, sense=-1.0, progress=report,
                 disabled=disabled, cases=index,
             )  # fmt: skip
 

@@ -38,6 +38,7 @@ from fixplan.planner.stacking import (
     set_given,
     set_units,
 )
+from fixplan.tolerances import MAX_SAFETY_FACTOR
 
 SOLVERS = ("CLARABEL", "OSQP", "SCS")
 
@@ -225,9 +226,44 @@ class Runner:
     def _run_block(
         self, objective, wrenches, given, sense, unloaded, accurate, disabled, numbers
     ) -> dict:
-        """One block (its load cases ``numbers`` among the problem's): with osculating
-        ellipsoids first where they apply, else (or where their rounds do not settle) with
-        cutting planes or no exact models at all."""
+        """One block (its load cases ``numbers`` among the problem's), and again for the cases
+        whose largest multiple shared it with cases at the cap ``MAX_SAFETY_FACTOR``.
+
+        Those carry forces ``MAX_SAFETY_FACTOR`` times their task loads, and the solver's
+        tolerances, relative to the largest terms, blur the others: a case held at every
+        multiple with a friction margin of 1e-4 came out held to 0.497, reported optimal."""
+        args = (wrenches, given, sense, unloaded, accurate, disabled, numbers)
+        result = self._solve_block(objective, *args)
+        if (
+            objective not in FIXED_FORCE_OBJECTIVES
+            or sense < 0
+            or result["status"] not in ("optimal", "inaccurate")
+        ):
+            return result
+        capped = result["scale"] >= MAX_SAFETY_FACTOR * (1.0 - 1e-6)
+        again = np.flatnonzero(~capped)
+        if not capped.any() or again.size == 0:
+            return result
+        padded = np.concatenate([again, np.full(len(numbers) - again.size, again[0])])
+        values = {i: v if np.ndim(v) == 0 else np.asarray(v)[padded] for i, v in given.items()}
+        redo = self._solve_block(
+            objective, wrenches[:, padded], values, sense,
+            None if unloaded is None else unloaded[:, padded], accurate, disabled,
+            numbers[padded],
+        )  # fmt: skip
+        if redo["status"] not in ("optimal", "inaccurate"):
+            return result
+        for key in ("normal", "friction", "scale", "dual", "known_use"):
+            if result.get(key) is not None and redo.get(key) is not None:
+                result[key][..., again] = redo[key][..., : again.size]
+        result["warnings"] = list(dict.fromkeys(result["warnings"] + redo["warnings"]))
+        return result
+
+    def _solve_block(
+        self, objective, wrenches, given, sense, unloaded, accurate, disabled, numbers
+    ) -> dict:
+        """One block: with osculating ellipsoids first where they apply, else (or where their
+        rounds do not settle) with cutting planes or no exact models at all."""
         unit = self._force_unit(wrenches, given)
         for osculating in (True, False) if self.osculating else (False,):
             key = (objective, osculating)
