@@ -147,3 +147,63 @@ def test_a_fixed_force_case_holds_up_to_the_better_of_its_two_multiples():
             if interval is not None:
                 highs.append(np.inf if interval[1] >= ref.K_MAX else interval[1])
         assert plan.safety_factors[load.name] == pytest.approx(max(highs), rel=AGREEMENT_RTOL)
+
+
+#: A random fixture of the review's brute force whose clamp stands beside the pads (x -0.047 m,
+#: y 0.025 m): more clamp force tips the plate, so a case's own least force need not hold the
+#: others.
+BESIDE = [
+    ("pad-0", "support", [-0.03976356750599487, -0.02099072607348129, 0.0], [0, 0, 1],
+     0.5843289818973504),
+    ("pad-1", "support", [0.03288319225439268, -0.021027011057255122, 0.0], [0, 0, 1],
+     0.39675854484918294),
+    ("pad-2", "support", [-0.003763370959790291, 0.03846652897945151, 0.0], [0, 0, 1],
+     0.8095858330855639),
+    ("side-left", "locator", [-0.06, 0.013108103752817669, 0.017275974091074838], [1, 0, 0],
+     0.37287534636248054),
+    ("side-right", "locator", [0.06, 0.013108103752817669, 0.017275974091074838], [-1, 0, 0],
+     0.5081481005325864),
+    ("back", "locator", [0.00198374750692238, -0.05, 0.02], [0, 1, 0], 0.22063752752244828),
+    ("clamp-top", "clamp", [-0.047244088675693165, 0.02535131086748066, 0.04], [0, 0, -1],
+     0.4628016878024164),
+]  # fmt: skip
+BESIDE_LOADS = [
+    ([-35.58537111886204, -28.52239914697806, 30.04376071560631],
+     [-0.013175474520837605, -0.0008885415341018978, 0.028844231988074315],
+     [0.9233143873275735, 0.4495798815470673, 0.08245371109486843]),
+    ([-26.7730555145555, -40.72175894698478, 56.3910495859359],
+     [0.0009641151328727213, -0.023048063251753778, 0.007409385332250024],
+     [0.553366228684596, 0.22600660210608092, 0.8345954095818053]),
+    ([-55.24885480029566, 3.430711591202595, -4.87969405375155],
+     [-0.026259025251007463, 0.008479690148362494, 0.021157970308839404],
+     [0.18588203620856802, -0.4798051045255536, 0.6797630420628176]),
+    ([1.139505782581125, 1.30666613598396, 30.363624924261345],
+     [-0.021124677852902604, 0.019177603147156615, 0.010997214360195427],
+     [0.5741938831096021, -0.6167674819597295, 0.60472832226906]),
+]  # fmt: skip
+
+
+def test_a_clamp_beside_the_supports_falls_back_to_one_unloading_for_every_case():
+    # Each case's own best asks for clamp forces that lose another case: that solve is
+    # infeasible. Unloading the left locator in every case holds, at the largest of the cases'
+    # least forces without it (the reference without side-left, case by case).
+    contacts = [
+        Contact(name=n, role=r, position=p, normal=d, mu=mu, model="point-cone")
+        for n, r, p, d, mu in BESIDE
+    ]
+    loads = [
+        Load(name=f"L{k}", force=f, point=p, torque=t) for k, (f, p, t) in enumerate(BESIDE_LOADS)
+    ]
+    problem = Problem(
+        body=Body(mass=0.9783098151430007, center_of_mass=[0.0, 0.0, 0.02]),
+        contacts=contacts,
+        loads=loads,
+        objective="min-total-clamp-force",
+    )
+    plan = Planner(problem).solve(analyse=False)
+    assert plan.status == "optimal"
+    expected = max(
+        ref.min_force_objective(without(problem, "side-left", j)) for j in range(len(BESIDE_LOADS))
+    )
+    assert plan.objective_value == pytest.approx(expected, rel=AGREEMENT_RTOL)
+    np.testing.assert_allclose(plan.normal_forces[3], 0.0, atol=1e-6 * plan.normal_forces.max())

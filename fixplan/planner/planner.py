@@ -43,7 +43,7 @@ from fixplan.planner.problem import (
     Problem,
 )
 from fixplan.planner.runner import SOLVERS, Runner
-from fixplan.planner.squeeze import choose_unloading, squeeze_members, squeezing
+from fixplan.planner.squeeze import choose_unloading, squeeze_members, squeezing, uniform_trials
 from fixplan.planner.stacking import REFINE, ContactLayout
 from fixplan.planner.verify import Verifier
 from fixplan.tolerances import MULTIPLE_ATOL
@@ -256,13 +256,35 @@ class Planner:
             )
             if not any(len(m) for m in members):
                 break
-            unloaded = choose_unloading(members, unloaded, rate)
+            before, unloaded = unloaded, choose_unloading(members, unloaded, rate)
             result = self._runner.run(objective, wrenches, given, unloaded=unloaded, **options)
+            if result["status"] == "infeasible" and objective not in FIXED_FORCE_OBJECTIVES:
+                # Each case's own best need not hold together: with a clamp beside the
+                # supports, more clamp force can lose a case. The same contact in every case
+                # may (the least objective of those that hold).
+                found = self._uniform(objective, wrenches, given, members, before, options)
+                if found is not None:
+                    result, unloaded = found
         for j, name in enumerate(load.name for load in self.problem.loads):
             found = tuple(n for n, u in zip(passive_names, unloaded[:, j], strict=True) if u)
             if found:
                 squeezed[name] = tuple(dict.fromkeys(squeezed.get(name, ()) + found))
         return result
+
+    def _uniform(self, objective, wrenches, given, members, unloaded, options):
+        """The best ``(result, unloading)`` of the force ``objective`` over the trials that
+        unload the same member of the squeeze in every case (``None`` if none holds)."""
+        roles = {c.name: c.role for c in self.problem.contacts}
+        best, found = np.inf, None
+        for trial in uniform_trials(members, unloaded):
+            result = self._runner.run(objective, wrenches, given, unloaded=trial, **options)
+            if result["status"] not in ("optimal", "inaccurate"):
+                continue
+            forces = self._active_forces(result["normal"])
+            value = objective_value(objective.removesuffix(REFINE), forces, roles, result["scale"])
+            if value < best:
+                best, found = value, (result, trial)
+        return found
 
     def _trial_scores(
         self, objective, wrenches, given, trial, decided, options, memo

@@ -22,7 +22,9 @@ or the largest multiple of a fixed-force objective), ties going to the first con
 is rated squeeze-free: where the case still holds a squeeze under it (the largest squeeze can
 join independent ones), by its best completion. With one free clamp force coupling the cases,
 and more clamp force losing no case, this is the least force over all choices; with several it
-is each case's own best, and another combination may need less.
+is each case's own best, and another combination may need less. Where the cases' own bests
+do not hold together (a clamp beside the supports, whose force can tip the part in another
+case), the same member is unloaded in every case (:func:`uniform_trials`), the best that holds.
 
 The rule is conservative: it only removes reactions that the rigid model admits, so forces are
 never lower and safety factors never higher than the rigid model's, and it never relies on a
@@ -86,14 +88,8 @@ def choose_unloading(
     the ``t``-th member of every case; scores within ``SQUEEZE_RTOL`` of a case's best go to
     its first member, so that the choice does not depend on rounding.
     """
-    count = max((len(m) for m in members), default=0)
-    trials = []
-    for t in range(count):
-        trial = unloaded.copy()
-        for j, m in enumerate(members):
-            if len(m):
-                trial[m[min(t, len(m) - 1)], j] = True
-        trials.append(trial)
+    trials = uniform_trials(members, unloaded)
+    count = len(trials)
     if count <= 1:
         return trials[0] if trials else unloaded.copy()
     sizes = np.array([len(m) for m in members])
@@ -103,6 +99,19 @@ def choose_unloading(
     slack = SQUEEZE_RTOL * np.maximum(np.abs(np.where(np.isfinite(best), best, 0.0)), 1.0)
     chosen = np.argmax(table <= (best + slack)[None, :], axis=0)  # first within; 0 if none solved
     return np.stack(trials)[chosen, :, np.arange(len(members))].T
+
+
+def uniform_trials(members: list[np.ndarray], unloaded: np.ndarray) -> list[np.ndarray]:
+    """The trials ``(P, K)``: ``unloaded`` with the ``t``-th of each case's squeeze ``members``
+    unloaded too (its last where it has fewer), ``t = 0, 1, ...``."""
+    trials = []
+    for t in range(max((len(m) for m in members), default=0)):
+        trial = unloaded.copy()
+        for j, m in enumerate(members):
+            if len(m):
+                trial[m[min(t, len(m) - 1)], j] = True
+        trials.append(trial)
+    return trials
 
 
 def _largest_squeeze(
