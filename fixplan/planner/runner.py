@@ -246,7 +246,11 @@ class Runner:
             return result
         padded = np.concatenate([again, np.full(len(numbers) - again.size, again[0])])
         values = {i: v if np.ndim(v) == 0 else np.asarray(v)[padded] for i, v in given.items()}
-        redo = self._solve_block(
+        # Through this method again where that leaves fewer cases (a case can reach the cap
+        # only without its capped block mates, and then blurs the others in turn); not where
+        # only copies of a case reached the cap (padding), which would repeat the same block.
+        fewer = np.unique(numbers[again]).size < np.unique(numbers).size
+        redo = (self._run_block if fewer else self._solve_block)(
             objective, wrenches[:, padded], values, sense,
             None if unloaded is None else unloaded[:, padded], accurate, disabled,
             numbers[padded],
@@ -256,6 +260,9 @@ class Runner:
         for key in ("normal", "friction", "scale", "dual", "known_use"):
             if result.get(key) is not None and redo.get(key) is not None:
                 result[key][..., again] = redo[key][..., : again.size]
+        result["status"] = max(result["status"], redo["status"], key=_SEVERITY.index)
+        solvers = f"{result['solver']}, {redo['solver']}".split(", ")
+        result["solver"] = ", ".join(dict.fromkeys(solvers))
         result["warnings"] = list(dict.fromkeys(result["warnings"] + redo["warnings"]))
         return result
 
