@@ -126,7 +126,10 @@ def test_small_batches_of_the_support_function_give_the_numpy_kernels_values(nam
     expected = surface._scale * surface._kernel.support(twists)
     np.testing.assert_allclose(surface.support(twists), expected, rtol=1e-13)
     assert surface.support(twists[5]) == pytest.approx(expected[5], rel=1e-13)
-    assert surface.support([0.0, 0.0, 0.0]) == 0.0  # (the NumPy disk kernels give NaN there)
+    assert surface.support([0.0, 0.0, 0.0]) == 0.0
+    many = np.vstack([np.zeros(3), twists, twists])  # (more than compiled: the NumPy kernels)
+    assert surface.support(many)[0] == 0.0
+    np.testing.assert_allclose(surface.support(many)[1:], np.tile(expected, 2), rtol=1e-13)
 
 
 def test_zero_loads_in_a_batch_are_held_with_no_motion():

@@ -24,6 +24,7 @@ import reference_planner as ref
 
 from fixplan import Body, Contact, Load, Planner, Problem
 from fixplan.planner import runner
+from fixplan.planner.squeeze import same_contact_trials
 
 SIDES = ("side-left", "side-right")
 AGREEMENT_RTOL = 1e-6
@@ -207,3 +208,15 @@ def test_a_clamp_beside_the_supports_falls_back_to_one_unloading_for_every_case(
     )
     assert plan.objective_value == pytest.approx(expected, rel=AGREEMENT_RTOL)
     np.testing.assert_allclose(plan.normal_forces[3], 0.0, atol=1e-6 * plan.normal_forces.max())
+
+
+def test_the_fallback_tries_each_contact_in_every_case_whose_squeeze_holds_it():
+    # Cases squeezed by different pairs: unloading contact 1 in both is one of the trials.
+    members = [np.array([0, 1]), np.array([1, 2])]
+    trials = same_contact_trials(members, np.zeros((3, 2), dtype=bool))
+    expected = [
+        [[True, False], [False, False], [False, False]],
+        [[False, False], [True, True], [False, False]],
+        [[False, False], [False, False], [False, True]],
+    ]
+    np.testing.assert_array_equal(np.array(trials), expected)

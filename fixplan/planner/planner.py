@@ -43,7 +43,12 @@ from fixplan.planner.problem import (
     Problem,
 )
 from fixplan.planner.runner import SOLVERS, Runner
-from fixplan.planner.squeeze import choose_unloading, squeeze_members, squeezing, uniform_trials
+from fixplan.planner.squeeze import (
+    choose_unloading,
+    same_contact_trials,
+    squeeze_members,
+    squeezing,
+)
 from fixplan.planner.stacking import REFINE, ContactLayout
 from fixplan.planner.verify import Verifier
 from fixplan.tolerances import MULTIPLE_ATOL
@@ -180,14 +185,14 @@ class Planner:
                 warnings.warn(note, stacklevel=2)
         forces = self._active_forces(result["normal"])
         if objective in FIXED_FORCE_OBJECTIVES:
-            extra = self._intervals(result, wrenches, given, squeezed, progress, off)
+            extra = self._intervals(result, wrenches, given, progress, off)
         elif analyse and status == "optimal":
             planned = {i: f for i, f in self._indexed(forces)}
             checked = self._squeeze_free(
                 "check", wrenches, planned, squeezed, progress=progress, disabled=off
             )
             if checked["status"] in ("optimal", "inaccurate"):
-                extra = self._intervals(checked, wrenches, planned, squeezed, progress, off)
+                extra = self._intervals(checked, wrenches, planned, progress, off)
             else:
                 notes.append(f"safety analysis of the forces found: {checked['status']}")
                 extra = {}
@@ -260,8 +265,8 @@ class Planner:
             result = self._runner.run(objective, wrenches, given, unloaded=unloaded, **options)
             if result["status"] == "infeasible" and objective not in FIXED_FORCE_OBJECTIVES:
                 # Each case's own best need not hold together: with a clamp beside the
-                # supports, more clamp force can lose a case. The same contact in every case
-                # may (the least objective of those that hold).
+                # supports, more clamp force can lose a case. One contact unloaded in every
+                # case may (the least objective of those that hold).
                 found = self._uniform(objective, wrenches, given, members, before, options)
                 if found is not None:
                     result, unloaded = found
@@ -273,10 +278,10 @@ class Planner:
 
     def _uniform(self, objective, wrenches, given, members, unloaded, options):
         """The best ``(result, unloading)`` of the force ``objective`` over the trials that
-        unload the same member of the squeeze in every case (``None`` if none holds)."""
+        unload one contact in every case whose squeeze holds it (``None`` if none holds)."""
         roles = {c.name: c.role for c in self.problem.contacts}
         best, found = np.inf, None
-        for trial in uniform_trials(members, unloaded):
+        for trial in same_contact_trials(members, unloaded):
             result = self._runner.run(objective, wrenches, given, unloaded=trial, **options)
             if result["status"] not in ("optimal", "inaccurate"):
                 continue
@@ -385,7 +390,7 @@ class Planner:
         )
         return refined if refined["status"] == "optimal" else result
 
-    def _intervals(self, highest, wrenches, given, squeezed, progress, disabled=None) -> dict:
+    def _intervals(self, highest, wrenches, given, progress, disabled=None) -> dict:
         """Held intervals, motions and utilisation of the given forces (``highest``: the
         maximising fixed-force solve)."""
         lowest = self._lowest(wrenches, given, progress, disabled)

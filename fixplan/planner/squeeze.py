@@ -24,7 +24,8 @@ join independent ones), by its best completion. With one free clamp force coupli
 and more clamp force losing no case, this is the least force over all choices; with several it
 is each case's own best, and another combination may need less. Where the cases' own bests
 do not hold together (a clamp beside the supports, whose force can tip the part in another
-case), the same member is unloaded in every case (:func:`uniform_trials`), the best that holds.
+case), one contact is unloaded in every case whose squeeze holds it (:func:`same_contact_trials`),
+the best that holds.
 
 The rule is conservative: it only removes reactions that the rigid model admits, so forces are
 never lower and safety factors never higher than the rigid model's, and it never relies on a
@@ -88,7 +89,7 @@ def choose_unloading(
     the ``t``-th member of every case; scores within ``SQUEEZE_RTOL`` of a case's best go to
     its first member, so that the choice does not depend on rounding.
     """
-    trials = uniform_trials(members, unloaded)
+    trials = member_trials(members, unloaded)
     count = len(trials)
     if count <= 1:
         return trials[0] if trials else unloaded.copy()
@@ -101,15 +102,29 @@ def choose_unloading(
     return np.stack(trials)[chosen, :, np.arange(len(members))].T
 
 
-def uniform_trials(members: list[np.ndarray], unloaded: np.ndarray) -> list[np.ndarray]:
-    """The trials ``(P, K)``: ``unloaded`` with the ``t``-th of each case's squeeze ``members``
-    unloaded too (its last where it has fewer), ``t = 0, 1, ...``."""
+def member_trials(members: list[np.ndarray], unloaded: np.ndarray) -> list[np.ndarray]:
+    """The trials ``(P, K)`` of :func:`choose_unloading`: ``unloaded`` with the ``t``-th of
+    each case's squeeze ``members`` unloaded too (its last where it has fewer),
+    ``t = 0, 1, ...``."""
     trials = []
     for t in range(max((len(m) for m in members), default=0)):
         trial = unloaded.copy()
         for j, m in enumerate(members):
             if len(m):
                 trial[m[min(t, len(m) - 1)], j] = True
+        trials.append(trial)
+    return trials
+
+
+def same_contact_trials(members: list[np.ndarray], unloaded: np.ndarray) -> list[np.ndarray]:
+    """The trials ``(P, K)`` that unload one contact in every case whose squeeze ``members``
+    hold it, one trial per contact of any case's squeeze (in increasing order)."""
+    trials = []
+    for contact in np.unique(np.concatenate([np.zeros(0, dtype=int), *members])):
+        trial = unloaded.copy()
+        for j, m in enumerate(members):
+            if contact in m:
+                trial[contact, j] = True
         trials.append(trial)
     return trials
 

@@ -218,12 +218,15 @@ class LimitSurface:
     # -- forward map ------------------------------------------------------------------------
 
     def support(self, twist) -> np.ndarray | float:
-        """Support function ``h(V)`` [W per unit speed] of twists ``(3,)`` or ``(K, 3)``."""
+        """Support function ``h(V)`` [W per unit speed] of twists ``(3,)`` or ``(K, 3)`` (0 at
+        a zero twist)."""
         twists, single = validation.vector_batch("twist", twist, width=3)
         if self._compiled is not None and len(twists) <= COMPILED_SUPPORT_MAX_TWISTS:
             values = self._scale * self._compiled.supports(twists)
         else:
-            values = self._scale * self._kernel.support(twists)
+            with np.errstate(invalid="ignore", divide="ignore"):  # (the disk kernels at 0)
+                values = self._scale * self._kernel.support(twists)
+            values[~np.any(twists != 0.0, axis=1)] = 0.0
         return float(values[0]) if single else values
 
     def support_hessian(self, twist) -> np.ndarray:
