@@ -56,3 +56,15 @@ def objective_value(objective: str, forces: dict, roles: dict, scale: np.ndarray
     if objective == "min-total-normal-force":
         return float(np.max(np.sum(per_case, axis=0)))
     return float(np.sum(np.square(per_case)))
+
+
+def active_forces(contacts, normal: np.ndarray) -> dict:
+    """The active normal forces of ``normal`` ``(C, K)`` [N] by contact name: a clamp's one
+    force, a finger's ``(K,)`` (negative solver noise clipped to 0)."""
+    forces = {}
+    for i, contact in enumerate(contacts):
+        if contact.role == "clamp":
+            forces[contact.name] = max(float(normal[i, 0]), 0.0)
+        elif contact.role == "finger":
+            forces[contact.name] = np.maximum(normal[i], 0.0)
+    return forces

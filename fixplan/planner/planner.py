@@ -13,15 +13,13 @@ normal forces; the fixed-force objectives find the interval of multiples ``k_j``
 (:mod:`fixplan.planner.stacking`), compiled once with Parameters for the loads and given forces
 and re-solved with new values (:mod:`fixplan.planner.runner`), verified in numpy
 (:mod:`fixplan.planner.verify`); passive contacts may not squeeze each other
-(:mod:`fixplan.planner.squeeze`). The dual of the equilibrium constraint of a case is the twist
-in which the body starts to slide; for an infeasible problem it is the motion that nothing
-resists (:mod:`fixplan.planner.certificate`).
+(:mod:`fixplan.planner.squeeze`, :mod:`fixplan.planner.unloading`). The dual of the equilibrium
+constraint of a case is the twist in which the body starts to slide; for an infeasible problem
+it is the motion that nothing resists (:mod:`fixplan.planner.certificate`).
 """
 
 from __future__ import annotations
 
-import dataclasses
-import functools
 import time
 import warnings
 from collections.abc import Callable, Sequence
@@ -33,7 +31,7 @@ from fixplan.planner.analysis import StayingInContact, analyse_cases
 from fixplan.planner.certificate import certificate
 from fixplan.planner.contact_models import contact_model
 from fixplan.planner.friction_use import FrictionUse
-from fixplan.planner.objectives import objective_value
+from fixplan.planner.objectives import active_forces, objective_value
 from fixplan.planner.plan import Plan
 from fixplan.planner.problem import (
     FIXED_FORCE_OBJECTIVES,
@@ -43,13 +41,9 @@ from fixplan.planner.problem import (
     Problem,
 )
 from fixplan.planner.runner import SOLVERS, Runner
-from fixplan.planner.squeeze import (
-    choose_unloading,
-    same_contact_trials,
-    squeeze_members,
-    squeezing,
-)
+from fixplan.planner.squeeze import squeezing
 from fixplan.planner.stacking import REFINE, ContactLayout
+from fixplan.planner.unloading import SqueezeFree
 from fixplan.planner.verify import Verifier
 from fixplan.tolerances import MULTIPLE_ATOL
 
@@ -102,7 +96,6 @@ class Planner:
         self._friction_component = np.concatenate(
             [np.arange(1, 1 + part.stop - part.start) for part in self.layout.slices]
         ).astype(np.intp)
-        self._passive_map = self.layout.normal_map[:, self._passive]
         self._staying = StayingInContact(self.layout.normal_map, self._passive, self.length_scale)
         self._verify = Verifier(problem, self.layout, self.friction_use, self.length_scale)
         passive_map = self.layout.normal_map[:, self._passive]
@@ -116,7 +109,11 @@ class Planner:
         self._runner = Runner(
             problem, self.layout, solver, squeeze=bool(self.squeeze_contacts), switchable=switchable
         )
-        self._alone: Runner | None = None  # one load case, to rate unloadings (squeezes)
+        #: Solves whose passive contacts hold no squeeze (see :mod:`fixplan.planner.unloading`).
+        self._squeeze_free = SqueezeFree(
+            problem, self.layout, self._runner, length_scale=self.length_scale,
+            squeezable=bool(self.squeeze_contacts),
+        ).solve  # fmt: skip
 
     def solve(
         self,
@@ -183,7 +180,7 @@ class Planner:
             notes += problems
             for note in problems:
                 warnings.warn(note, stacklevel=2)
-        forces = self._active_forces(result["normal"])
+        forces = active_forces(self.problem.contacts, result["normal"])
         if objective in FIXED_FORCE_OBJECTIVES:
             extra = self._intervals(result, wrenches, given, progress, off)
         elif analyse and status == "optimal":
@@ -223,153 +220,6 @@ class Planner:
         if unknown:
             raise InvalidArgumentError(f"disabled names unknown contacts: {', '.join(unknown)}")
         return np.isin(names, disabled)
-
-    def _squeeze_free(
-        self,
-        objective,
-        wrenches,
-        given,
-        squeezed,
-        *,
-        sense=1.0,
-        accurate=False,
-        progress=None,
-        disabled=None,
-        cases=None,
-    ):
-        """Solve ``objective``, unloading passive contacts until no case holds a squeeze.
-
-        ``squeezed`` collects, per load case name, the contacts unloaded (for the notes);
-        ``disabled`` ``(C,)`` bool marks the contacts switched off; ``cases`` numbers the load
-        cases of ``wrenches`` among the problem's (default: all, in order).
-        """
-        options = {"sense": sense, "accurate": accurate, "progress": progress,
-                   "disabled": disabled, "cases": cases}  # fmt: skip
-        result = self._runner.run(objective, wrenches, given, **options)
-        if not self.squeeze_contacts:
-            return result
-        passive_map = self.layout.normal_map[:, self._passive]
-        unloaded = np.zeros((int(self._passive.sum()), wrenches.shape[1]), dtype=bool)
-        passive_names = [c.name for c in self.problem.contacts if c.role in PASSIVE_ROLES]
-        rate = functools.partial(self._trial_scores, objective, wrenches, given,
-                                 options=dict(options, progress=None), memo={})  # fmt: skip
-        for _ in range(len(passive_names)):
-            if result["status"] not in ("optimal", "inaccurate"):
-                break
-            members = squeeze_members(
-                passive_map, result["normal"][self._passive], self.length_scale
-            )
-            if not any(len(m) for m in members):
-                break
-            before, unloaded = unloaded, choose_unloading(members, unloaded, rate)
-            result = self._runner.run(objective, wrenches, given, unloaded=unloaded, **options)
-            if result["status"] == "infeasible" and objective not in FIXED_FORCE_OBJECTIVES:
-                # Each case's own best need not hold together: with a clamp beside the
-                # supports, more clamp force can lose a case. One contact unloaded in every
-                # case may (the least objective of those that hold).
-                found = self._uniform(objective, wrenches, given, members, before, options)
-                if found is not None:
-                    result, unloaded = found
-        for j, name in enumerate(load.name for load in self.problem.loads):
-            found = tuple(n for n, u in zip(passive_names, unloaded[:, j], strict=True) if u)
-            if found:
-                squeezed[name] = tuple(dict.fromkeys(squeezed.get(name, ()) + found))
-        return result
-
-    def _uniform(self, objective, wrenches, given, members, unloaded, options):
-        """The best ``(result, unloading)`` of the force ``objective`` over the trials that
-        unload one contact in every case whose squeeze holds it (``None`` if none holds)."""
-        roles = {c.name: c.role for c in self.problem.contacts}
-        best, found = np.inf, None
-        for trial in same_contact_trials(members, unloaded):
-            result = self._runner.run(objective, wrenches, given, unloaded=trial, **options)
-            if result["status"] not in ("optimal", "inaccurate"):
-                continue
-            forces = self._active_forces(result["normal"])
-            value = objective_value(objective.removesuffix(REFINE), forces, roles, result["scale"])
-            if value < best:
-                best, found = value, (result, trial)
-        return found
-
-    def _trial_scores(
-        self, objective, wrenches, given, trial, decided, options, memo
-    ) -> np.ndarray:
-        """How well a trial unloading ``trial`` ``(passive, K)`` serves each load case
-        ``decided`` ``(K,)`` on its own (see :func:`~fixplan.planner.squeeze.choose_unloading`):
-        the task-load multiple (sign of ``sense``, larger first) of a fixed-force objective,
-        whose cases are independent; else the objective of the case solved alone (free clamps
-        couple the cases). ``inf`` where not solved or not decided.
-
-        A case whose answer under the trial still holds a squeeze (the largest squeeze of a
-        case can join several independent ones: two opposing pairs) is rated by the best of
-        its squeeze-free completions (:meth:`_case_best`): rated as it stands, the other
-        squeeze would still carry it, and every member would tie. ``memo`` keeps the ratings
-        of (case, unloading) of one squeeze-free solve."""
-        scores = np.full(wrenches.shape[1], np.inf)
-        numbers = np.arange(wrenches.shape[1]) if options["cases"] is None else options["cases"]
-        rest = decided.copy()
-        if objective in FIXED_FORCE_OBJECTIVES:
-            # Cases are independent: one run for all, and alone only the cases it does not
-            # settle (still squeezed, or lost with the run: its status is its worst block's).
-            result = self._runner.run(objective, wrenches, given, unloaded=trial, **options)
-            if result["status"] in ("optimal", "inaccurate"):
-                passive = result["normal"][self._passive]
-                members = squeeze_members(self._passive_map, passive, self.length_scale)
-                for j in np.flatnonzero(decided):
-                    if not len(members[j]):
-                        scores[j] = -options["sense"] * result["scale"][j]
-                        rest[j] = False
-        for j in np.flatnonzero(rest):
-            values = {
-                i: v if np.ndim(v) == 0 else float(np.asarray(v)[j]) for i, v in given.items()
-            }
-            scores[j] = self._case_best(
-                objective, wrenches[:, [j]], values, trial[:, j].copy(), int(numbers[j]), options,
-                memo,
-            )  # fmt: skip
-        return scores
-
-    def _case_best(self, objective, wrench, values, column, number, options, memo) -> float:
-        """The best rating (lower is better) of load case ``number`` solved alone (task
-        ``wrench`` ``(6, 1)``, given forces ``values``) over the squeeze-free completions of
-        the unloading ``column`` ``(passive,)``: where its answer holds a squeeze, each
-        member is unloaded in turn."""
-        key = (number, column.tobytes())
-        if key in memo:
-            return memo[key]
-        memo[key] = np.inf  # (an unloading is only ever extended)
-        ok = ("optimal", "inaccurate")
-        run = {"sense": options["sense"], "accurate": options["accurate"],
-               "disabled": options["disabled"], "cases": np.array([number])}  # fmt: skip
-        if objective in FIXED_FORCE_OBJECTIVES:
-            runner = self._runner
-        else:
-            if self._alone is None:
-                alone = dataclasses.replace(self.problem, loads=self.problem.loads[:1])
-                self._alone = Runner(alone, self.layout, self.solver, squeeze=True,
-                                     switchable=self.switchable)  # fmt: skip
-            runner = self._alone
-        result = runner.run(objective, wrench, values, unloaded=column[:, None], **run)
-        best = np.inf
-        if result["status"] in ok:
-            passive = result["normal"][self._passive]
-            members = squeeze_members(self._passive_map, passive, self.length_scale)[0]
-            if not len(members):
-                if objective in FIXED_FORCE_OBJECTIVES:
-                    best = -options["sense"] * float(result["scale"][0])
-                else:
-                    roles = {c.name: c.role for c in self.problem.contacts}
-                    forces = self._active_forces(result["normal"])
-                    best = objective_value(
-                        objective.removesuffix(REFINE), forces, roles, result["scale"]
-                    )
-            for member in members:
-                more = column.copy()
-                more[member] = True
-                best = min(best, self._case_best(objective, wrench, values, more, number,
-                                                 options, memo))  # fmt: skip
-        memo[key] = best
-        return best
 
     def _refine(self, objective, result, wrenches, given, squeezed, disabled=None) -> dict:
         """Second stage of a force objective whose free clamps couple the load cases.
@@ -465,15 +315,6 @@ class Planner:
             warnings=tuple(notes),
             **fields,
         )
-
-    def _active_forces(self, normal) -> dict:
-        forces = {}
-        for i, contact in enumerate(self.problem.contacts):
-            if contact.role == "clamp":
-                forces[contact.name] = max(float(normal[i, 0]), 0.0)
-            elif contact.role == "finger":
-                forces[contact.name] = np.maximum(normal[i], 0.0)
-        return forces
 
     def _wrenches(self, normal, friction) -> np.ndarray:
         contacts, cases = normal.shape

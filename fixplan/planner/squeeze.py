@@ -16,16 +16,16 @@ normal force in that case, and the problem is solved again, until no case contai
 Which contact: the squeeze-free problem is not convex (a union over the choices), and the
 solver's answer, one of many optima of the rigid problem, says nothing reliable about it (the
 forces a squeeze loads most in proportion flip with rounding: 426 N or 13,698 N for the same
-fixture). So every member is tried, case by case (:func:`choose_unloading`; the planner rates
-the trials): each load case takes the member that serves it best on its own (the least forces,
-or the largest multiple of a fixed-force objective), ties going to the first contact. A trial
-is rated squeeze-free: where the case still holds a squeeze under it (the largest squeeze can
-join independent ones), by its best completion. With one free clamp force coupling the cases,
-and more clamp force losing no case, this is the least force over all choices; with several it
-is each case's own best, and another combination may need less. Where the cases' own bests
-do not hold together (a clamp beside the supports, whose force can tip the part in another
-case), one contact is unloaded in every case whose squeeze holds it (:func:`same_contact_trials`),
-the best that holds.
+fixture). So every member is tried, case by case (:func:`choose_unloading`;
+:mod:`fixplan.planner.unloading` rates the trials): each load case takes the member that serves
+it best on its own (the least forces, or the largest multiple of a fixed-force objective), ties
+going to the first contact. A trial is rated squeeze-free: where the case still holds a squeeze
+under it (the largest squeeze can join independent ones), by its best completion. With one free
+clamp force coupling the cases, and more clamp force losing no case, this is the least force
+over all choices; with several it is each case's own best, and another combination may need
+less. Where the cases' own bests do not hold together (a clamp beside the supports, whose force
+can tip the part in another case), one contact is unloaded in every case whose squeeze holds it
+(:func:`same_contact_trials`), the best that holds.
 
 The rule is conservative: it only removes reactions that the rigid model admits, so forces are
 never lower and safety factors never higher than the rigid model's, and it never relies on a
