@@ -21,6 +21,7 @@ import dataclasses
 import numpy as np
 import pytest
 import reference_planner as ref
+from test_squeeze_brute_force import largest_multiple, without
 
 from fixplan import Body, Contact, Load, Planner, Problem
 from fixplan.planner import runner
@@ -64,22 +65,13 @@ def plate() -> Problem:
     )
 
 
-def without(problem: Problem, name: str, case: int) -> Problem:
-    """Load case ``case`` alone, contact ``name`` left out."""
-    return dataclasses.replace(
-        problem,
-        contacts=[c for c in problem.contacts if c.name != name],
-        loads=[problem.loads[case]],
-    )
-
-
 @pytest.fixture(scope="module")
 def case_least_forces():
     """Per case, the reference's least clamp force without each side locator (None:
     infeasible)."""
     problem = plate()
     return [
-        {side: ref.min_force_objective(without(problem, side, j)) for side in SIDES}
+        {side: ref.min_force_objective(without(problem, {side}, j)) for side in SIDES}
         for j in range(len(LOADS))
     ]
 
@@ -142,12 +134,8 @@ def test_a_fixed_force_case_holds_up_to_the_better_of_its_two_multiples():
     plan = Planner(given).solve()
     assert plan.status == "optimal"
     for j, load in enumerate(given.loads):
-        highs = []
-        for side in SIDES:
-            interval = ref.held_interval(without(given, side, j), 0, None)
-            if interval is not None:
-                highs.append(np.inf if interval[1] >= ref.K_MAX else interval[1])
-        assert plan.safety_factors[load.name] == pytest.approx(max(highs), rel=AGREEMENT_RTOL)
+        expected = largest_multiple(given, j, [{side} for side in SIDES])
+        assert plan.safety_factors[load.name] == pytest.approx(expected, rel=AGREEMENT_RTOL)
 
 
 #: A random fixture of the review's brute force whose clamp stands beside the pads (x -0.047 m,
@@ -204,7 +192,8 @@ def test_a_clamp_beside_the_supports_falls_back_to_one_unloading_for_every_case(
     plan = Planner(problem).solve(analyse=False)
     assert plan.status == "optimal"
     expected = max(
-        ref.min_force_objective(without(problem, "side-left", j)) for j in range(len(BESIDE_LOADS))
+        ref.min_force_objective(without(problem, {"side-left"}, j))
+        for j in range(len(BESIDE_LOADS))
     )
     assert plan.objective_value == pytest.approx(expected, rel=AGREEMENT_RTOL)
     np.testing.assert_allclose(plan.normal_forces[3], 0.0, atol=1e-6 * plan.normal_forces.max())
