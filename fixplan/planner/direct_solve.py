@@ -227,12 +227,14 @@ class _Program:
         self._columns = [(p, program.param_id_to_col[p.id], p.size) for p in parameters]
         self._size = program.total_param_size + 1  # the last entry is the constant 1
         self._variables = program.x.size
+        # The parameter vector with every parameter 0: a map applied to it is its constant part.
+        constant = np.r_[np.zeros(self._size - 1), 1.0]
         q_map = sp.csr_array(program.q)
         self._q = _for_products(q_map)
         #: ``(q, constant)`` where the cost does not depend on the parameters, else ``None``.
         self._fixed_cost = None
         if q_map[:, : self._size - 1].nnz == 0:
-            full = q_map @ np.r_[np.zeros(self._size - 1), 1.0]
+            full = q_map @ constant
             self._fixed_cost = (full[: self._variables], float(full[self._variables]))
         program.reduced_A.cache()
         a_map = sp.csr_array(program.reduced_A.reduced_mat)
@@ -250,7 +252,7 @@ class _Program:
         #: Where ``A`` is fixed: its values, and the map of ``b`` alone.
         self._fixed_values = None
         if self.fixed_a:
-            self._fixed_values = -(a_map[: self._split] @ np.r_[np.zeros(self._size - 1), 1.0])
+            self._fixed_values = -(a_map[: self._split] @ constant)
             self._b_map = _for_products(a_map[self._split :])
         if program.reduced_P is None or program.reduced_P.matrix_data is None:
             self.quadratic = sp.csc_matrix((self._variables, self._variables))
@@ -260,7 +262,7 @@ class _Program:
             p_map = sp.csr_array(program.reduced_P.reduced_mat)
             self.parametric_p = p_map[:, :-1].nnz > 0
             p_indices, p_indptr, p_shape = program.reduced_P.problem_data_index
-            values = p_map @ np.r_[np.zeros(self._size - 1), 1.0]
+            values = p_map @ constant
             full = sp.csc_matrix((values, p_indices, p_indptr), shape=p_shape)
             self.quadratic = sp.csc_matrix(sp.triu(full))
 

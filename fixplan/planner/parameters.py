@@ -8,7 +8,7 @@ import numpy as np
 
 def assign(parameter: cp.Parameter, value) -> None:
     """Set ``parameter`` to ``value`` (broadcast to its shape) without cvxpy's validation,
-    which costs more than a direct re-solve (about 100 µs for a ``(8, 20)`` array): the
+    which costs 43 µs for an ``(8, 20)`` Parameter against 1 µs here: the
     planner's values are checked where they come from (loads, given forces >= 0, multiples,
     the exact models' ellipsoids and cuts)."""
     array = np.asarray(value, dtype=float)
@@ -20,7 +20,8 @@ def assign(parameter: cp.Parameter, value) -> None:
 def part_values(parts: tuple, shape: tuple[int, int]) -> np.ndarray:
     """The value ``shape`` ``(rows, K)`` of a matrix stacked from ``parts``: ``(row indices,
     variable or parameter)`` pairs, a 1-D part being the same in every column. Read from the
-    parts' values: cvxpy evaluates the stacked expression itself in about 100 µs."""
+    parts' values in 4 µs (8 contacts × 20 cases), where cvxpy evaluates the stacked
+    expression in 28 µs."""
     out = np.zeros(shape)
     for index, piece in parts:
         values = np.asarray(piece.value, dtype=float)

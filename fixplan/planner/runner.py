@@ -10,8 +10,9 @@ once with a fallback solver.
 
 Every block is solved in a force unit of its own, a power of two (which divides without
 rounding) that puts its largest force (the components of the task forces, of the task torques
-over the contacts' longest lever, the weight, the given forces) near ``FORCE_IN_UNITS``: the task and gravity wrenches, the
-given forces and the ``max_force`` bounds are divided by it and the answers multiplied back.
+over the contacts' longest lever, the weight, the given forces) near ``FORCE_IN_UNITS``: the
+task and gravity wrenches, the given forces and the ``max_force`` bounds are divided by it and
+the answers multiplied back.
 The friction sets are cones, so the program in other units is the same program, but Clarabel's
 answers are not equally good in all of them (its tolerances are partly absolute).
 """
@@ -191,7 +192,7 @@ class Runner:
         block = self.block_size(objective)
         if cases == block:  # one block, no padding (re-solves in a control loop)
             result = self._run_block(
-                objective, wrenches, given, sense, unloaded, accurate, disabled, numbers
+                objective, wrenches, given, unloaded, numbers, sense, accurate, disabled
             )
             if progress is not None:
                 progress(cases, cases)
@@ -202,15 +203,9 @@ class Runner:
         results = []
         for start in range(0, cases, block):
             index = order[start : min(start + block, cases)]
-            padded = np.concatenate([index, np.full(block - len(index), index[0])])
-            values = {
-                i: (v if np.ndim(v) == 0 else np.broadcast_to(v, (cases,))[padded])
-                for i, v in given.items()
-            }
-            mask = None if unloaded is None else unloaded[:, padded]
             result = self._run_block(
-                objective, wrenches[:, padded], values, sense, mask, accurate, disabled,
-                numbers[padded],
+                objective, *_block_of(index, block, wrenches, given, unloaded, numbers), sense,
+                accurate, disabled,
             )  # fmt: skip
             results.append((result, len(index)))
             if progress is not None:
@@ -224,7 +219,7 @@ class Runner:
         return merged
 
     def _run_block(
-        self, objective, wrenches, given, sense, unloaded, accurate, disabled, numbers
+        self, objective, wrenches, given, unloaded, numbers, sense, accurate, disabled
     ) -> dict:
         """One block (its load cases ``numbers`` among the problem's), and again for the cases
         whose largest multiple shared it with cases at the cap ``MAX_SAFETY_FACTOR``.
@@ -232,8 +227,9 @@ class Runner:
         Those carry forces ``MAX_SAFETY_FACTOR`` times their task loads, and the solver's
         tolerances, relative to the largest terms, blur the others: a case held at every
         multiple with a friction margin of 1e-4 came out held to 0.497, reported optimal."""
-        args = (wrenches, given, sense, unloaded, accurate, disabled, numbers)
-        result = self._solve_block(objective, *args)
+        result = self._solve_block(
+            objective, wrenches, given, unloaded, numbers, sense, accurate, disabled
+        )
         if (
             objective not in FIXED_FORCE_OBJECTIVES
             or sense < 0
@@ -245,16 +241,13 @@ class Runner:
         again = np.flatnonzero(~capped)
         if not capped.any() or again.size == 0:
             return result
-        padded = np.concatenate([again, np.full(len(numbers) - again.size, again[0])])
-        values = {i: v if np.ndim(v) == 0 else np.asarray(v)[padded] for i, v in given.items()}
         # Through this method again where that leaves fewer cases (a case can reach the cap
         # only without its capped block mates, and then blurs the others in turn); not where
         # only copies of a case reached the cap (padding), which would repeat the same block.
         fewer = np.unique(numbers[again]).size < np.unique(numbers).size
         redo = (self._run_block if fewer else self._solve_block)(
-            objective, wrenches[:, padded], values, sense,
-            None if unloaded is None else unloaded[:, padded], accurate, disabled,
-            numbers[padded],
+            objective, *_block_of(again, len(numbers), wrenches, given, unloaded, numbers),
+            sense, accurate, disabled,
         )  # fmt: skip
         if redo["status"] not in ("optimal", "inaccurate"):
             return result
@@ -267,7 +260,7 @@ class Runner:
         return result
 
     def _solve_block(
-        self, objective, wrenches, given, sense, unloaded, accurate, disabled, numbers
+        self, objective, wrenches, given, unloaded, numbers, sense, accurate, disabled
     ) -> dict:
         """One block: with osculating ellipsoids first where they apply, else (or where their
         rounds do not settle) with cutting planes or no exact models at all."""
@@ -451,6 +444,18 @@ def _similar_order(wrenches: np.ndarray) -> np.ndarray:
             similarity = np.where(left, unit[:, current] @ unit, -np.inf)
             current = int(np.argmax(similarity))
     return order
+
+
+def _block_of(index, size, wrenches, given, unloaded, numbers) -> tuple:
+    """The task wrenches, given forces, unloaded contacts and case numbers of the cases
+    ``index`` (columns of ``wrenches``), padded with copies of the first to ``size`` cases."""
+    padded = np.concatenate([index, np.full(size - len(index), index[0])])
+    cases = wrenches.shape[1]
+    values = {
+        i: v if np.ndim(v) == 0 else np.broadcast_to(v, (cases,))[padded] for i, v in given.items()
+    }
+    mask = None if unloaded is None else unloaded[:, padded]
+    return wrenches[:, padded], values, mask, numbers[padded]
 
 
 def _linear(model) -> bool:

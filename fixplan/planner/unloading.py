@@ -101,14 +101,12 @@ class SqueezeFree:
     def _uniform(self, objective, wrenches, given, members, unloaded, options):
         """The best ``(result, unloading)`` of the force ``objective`` over the trials that
         unload one contact in every case whose squeeze holds it (``None`` if none holds)."""
-        roles = {c.name: c.role for c in self.problem.contacts}
         best, found = np.inf, None
         for trial in same_contact_trials(members, unloaded):
             result = self._runner.run(objective, wrenches, given, unloaded=trial, **options)
             if result["status"] not in ("optimal", "inaccurate"):
                 continue
-            forces = active_forces(self.problem.contacts, result["normal"])
-            value = objective_value(objective.removesuffix(REFINE), forces, roles, result["scale"])
+            value = self._force_objective(objective, result)
             if value < best:
                 best, found = value, (result, trial)
         return found
@@ -181,11 +179,7 @@ class SqueezeFree:
                 if objective in FIXED_FORCE_OBJECTIVES:
                     best = -options["sense"] * float(result["scale"][0])
                 else:
-                    roles = {c.name: c.role for c in self.problem.contacts}
-                    forces = active_forces(self.problem.contacts, result["normal"])
-                    best = objective_value(
-                        objective.removesuffix(REFINE), forces, roles, result["scale"]
-                    )
+                    best = self._force_objective(objective, result)
             for member in members:
                 more = column.copy()
                 more[member] = True
@@ -193,3 +187,10 @@ class SqueezeFree:
                                                  options, memo))  # fmt: skip
         memo[key] = best
         return best
+
+    def _force_objective(self, objective: str, result: dict) -> float:
+        """The value [N or N²] of the force ``objective`` (or its refining stage) at the active
+        forces of ``result``."""
+        forces = active_forces(self.problem.contacts, result["normal"])
+        roles = {c.name: c.role for c in self.problem.contacts}
+        return objective_value(objective.removesuffix(REFINE), forces, roles, result["scale"])
