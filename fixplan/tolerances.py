@@ -42,6 +42,10 @@ EXACT_CUT_RTOL = 1e-9
 #: problems badly scaled (reactions a million times the loads).
 MAX_SAFETY_FACTOR = 1e3
 
+#: A multiple within this fraction of ``MAX_SAFETY_FACTOR`` counts as at the cap: inaccurate
+#: answers (SCS) leave capped cases at 999.75 to 1039, so 999 and up are reported infinite.
+CAP_RTOL = 1e-3
+
 #: Smallest eigenvalue of a fitted ellipsoid's matrix in normalised coordinates: keeps the fit
 #: positive definite (a bounded set) when the data leave a direction unconstrained.
 FIT_MIN_EIGENVALUE = 1e-6

@@ -237,3 +237,32 @@ def test_a_case_is_not_blurred_by_a_block_mate_that_reaches_the_cap_only_when_so
     assert min(highs[:2]) >= 1e3
     assert plan.safety_factors["L2"] == plan.safety_factors["blend"] == np.inf
     assert plan.safety_factors["L1"] == pytest.approx(highs[2], rel=1e-6)
+
+
+def test_the_cases_of_a_block_the_solver_fails_on_are_solved_one_by_one():
+    # The wedged plate with pad-1's friction cut to 30 %, and three loads in one block: the
+    # last of the plate's (held at every multiple), a blend of the first two on the edge of
+    # those held at every multiple (Clarabel ends inaccurate on it, alone too) and their
+    # midpoint, held to 0.373. Clarabel ends inaccurate on the block, and SCS on the whole
+    # block said 0.765: an unsafe safety factor, twice the true one. Each case alone is right.
+    import reference_planner as ref
+
+    wedged = wedged_plate()
+    contacts = [dataclasses.replace(c, mu=0.3 * c.mu) if c.name == "pad-1" else c
+                for c in wedged.contacts]  # fmt: skip
+    first, second = (np.asarray(load.wrench, dtype=float) for load in wedged.loads[:2])
+    t = 0.07280627323856354  # (the edge: 0.0728064)
+    wrenches = {"edge": (1.0 - t) * first + t * second, "middle": 0.5 * (first + second)}
+    loads = [wedged.loads[2]] + [
+        Load(name=name, force=w[:3], point=[0.0, 0.0, 0.0], torque=w[3:])
+        for name, w in wrenches.items()
+    ]
+    problem = dataclasses.replace(wedged, contacts=contacts, loads=loads)
+    plan = Planner(problem).solve()
+    assert plan.status in ("optimal", "inaccurate")  # (the edge case alone needs SCS)
+    assert any("solved them one by one" in note for note in plan.warnings)
+    low, high = ref.held_interval(problem, 2, None)
+    assert high == pytest.approx(0.372939731448873, rel=1e-9)  # (the reference is stable)
+    assert plan.safety_factors["middle"] == pytest.approx(high, rel=1e-6)
+    assert plan.held_intervals["middle"][0] == pytest.approx(low, abs=1e-7)
+    assert plan.safety_factors["L2"] == np.inf

@@ -23,7 +23,13 @@ from fixplan.planner.friction_use import FrictionUse
 from fixplan.planner.problem import Problem
 from fixplan.planner.screw import Screw
 from fixplan.surface.point_kernel import compiled_scalar
-from fixplan.tolerances import FRICTION_SET_RTOL, HELD_RTOL, MAX_SAFETY_FACTOR, MULTIPLE_ATOL
+from fixplan.tolerances import (
+    CAP_RTOL,
+    FRICTION_SET_RTOL,
+    HELD_RTOL,
+    MAX_SAFETY_FACTOR,
+    MULTIPLE_ATOL,
+)
 
 
 def analyse_cases(
@@ -42,7 +48,8 @@ def analyse_cases(
     k_max = np.array(highest["scale"], dtype=float)
     k_min = np.zeros_like(k_max) if lowest is None else np.array(lowest["scale"], dtype=float)
     held = np.empty(len(k_max), dtype=np.bool_)
-    critical = _MULTIPLES(k_max, k_min, held, MAX_SAFETY_FACTOR, MULTIPLE_ATOL, HELD_RTOL)
+    cap = MAX_SAFETY_FACTOR * (1.0 - CAP_RTOL)
+    critical = _MULTIPLES(k_max, k_min, held, cap, MULTIPLE_ATOL, HELD_RTOL)
     normal, friction, dual = highest["normal"], highest["friction"], highest.get("dual")
     motions = dict.fromkeys(names)
     if dual is not None:
@@ -130,12 +137,12 @@ class StayingInContact:
 
 def multiples(k_max, k_min, held, cap, atol, held_rtol):  # pragma: no cover - compiled
     """Clean the multiples of the two solves in place (solver noise below 0 and below
-    ``atol``, the ``cap`` as infinity), mark the held cases; the critical case: the first of
+    ``atol``, from ``cap`` on as infinity), mark the held cases; the critical case: the first of
     those tied (within ``held_rtol``) with the smallest margin ``min(k_max, 1 / k_min)``."""
     margins = np.empty(k_max.shape[0])
     for j in range(k_max.shape[0]):
         high = max(k_max[j], 0.0)  # the solver may return -1e-19 for 0
-        k_max[j] = np.inf if high >= cap * (1 - 1e-6) else high
+        k_max[j] = np.inf if high >= cap else high
         low = max(k_min[j], 0.0)
         k_min[j] = 0.0 if low < atol else low
         margins[j] = min(k_max[j], 1.0 / k_min[j] if k_min[j] > 0.0 else np.inf)
