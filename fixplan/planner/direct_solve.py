@@ -111,15 +111,27 @@ class DirectSolver:
             return None
         return direct
 
-    def solve(self, *, accept_inaccurate: bool = False) -> dict | None:
-        """Variable values by id after a solve with the parameters' current values.
+    def parameter_vector(self) -> np.ndarray:
+        """The parameter vector of the parameters' current values (the last entry 1)."""
+        return self._program.parameter_vector()
+
+    def entries(self, parameter: cp.Parameter) -> slice:
+        """Where ``parameter``'s values sit in the parameter vector (column-major)."""
+        return self._program.entries(parameter)
+
+    def solve(
+        self, *, accept_inaccurate: bool = False, vector: np.ndarray | None = None
+    ) -> dict | None:
+        """Variable values by id after a solve with the parameters' current values (or those
+        of the parameter ``vector``, :meth:`parameter_vector`'s layout).
 
         A linear program goes to the warm-started dual simplex first, and to Clarabel where the
         simplex gives up (:mod:`fixplan.planner.dual_simplex`). ``None`` when Clarabel does not
         report the problem solved (or almost solved, with ``accept_inaccurate``); :attr:`status`
         says why (use cvxpy then: it turns infeasibility into certificates).
         """
-        vector = self._program.parameter_vector()
+        if vector is None:
+            vector = self._program.parameter_vector()
         q, constant = self._program.cost(vector)
         a, b = self._program.constraints(vector)
         found = self._simplex_solve(q, a, b)
@@ -272,6 +284,12 @@ class _Program:
         for parameter, column, size in self._columns:
             vector[column : column + size] = np.ravel(parameter.value, order="F")
         return vector
+
+    def entries(self, parameter) -> slice:
+        for known, column, size in self._columns:
+            if known is parameter:
+                return slice(column, column + size)
+        raise KeyError(parameter.name())
 
     def cost(self, vector) -> tuple[np.ndarray, float]:
         """``q`` and the constant of the cost."""

@@ -364,9 +364,11 @@ def build(
     )
 
 
-def normal_forces(stacked: Stacked) -> np.ndarray:
-    """The normal forces ``(C, K)`` [N] of the last solve, from the values of their parts."""
-    return part_values(stacked.normal_parts, (len(stacked.decided), stacked.task.shape[1]))
+def normal_forces(stacked: Stacked, solved: dict | None = None) -> np.ndarray:
+    """The normal forces ``(C, K)`` [N] of the last solve, from the values of their parts (the
+    variables' from ``solved``, by id, where given)."""
+    shape = (len(stacked.decided), stacked.task.shape[1])
+    return part_values(stacked.normal_parts, shape, solved)
 
 
 def set_units(stacked: Stacked, weight_wrench: np.ndarray, unit: float = 1.0) -> None:

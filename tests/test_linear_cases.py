@@ -1,0 +1,144 @@
+"""The cases of a linear fixed-force objective, one by one straight through the direct solver
+(``Runner._one_by_one``), against the general path of one block per case."""
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fixplan.io.problem_file import load_problem
+from fixplan.planner.planner import Planner
+from fixplan.planner.problem import Body, Contact, Load, Problem
+from fixplan.planner.runner import Runner
+
+
+@pytest.fixture
+def block_path(monkeypatch):
+    """Plans through the general path: the one-by-one lane declined."""
+
+    def solve(problem):
+        with monkeypatch.context() as patch:
+            patch.setattr(Runner, "_one_by_one", lambda self, *args: None)
+            return Planner(problem).solve()
+
+    return solve
+
+
+@pytest.fixture
+def lane_used(monkeypatch):
+    """The number of cases of each call the one-by-one lane answered."""
+    answered = []
+    original = Runner._one_by_one
+
+    def spy(self, *args):
+        merged = original(self, *args)
+        if merged is not None:
+            answered.append(args[1].shape[1])  # (the task wrenches)
+        return merged
+
+    monkeypatch.setattr(Runner, "_one_by_one", spy)
+    return answered
+
+
+def _turned_fixture_321(count: int) -> Problem:
+    """fixture-321 (pyramids) at its planned clamp forces, ``count`` turned load cases."""
+    problem = load_problem(Path(__file__).resolve().parents[1] / "problems" / "fixture-321.toml")
+    problem = problem.problem
+    forces = Planner(problem).solve().forces
+    contacts = tuple(
+        dataclasses.replace(c, force=float(forces[c.name])) if c.name in forces else c
+        for c in problem.contacts
+    )
+    rng = np.random.default_rng(7)
+    loads = []
+    for k in range(count):
+        base = problem.loads[k % len(problem.loads)]
+        angle, size = rng.uniform(-np.pi, np.pi), rng.uniform(0.2, 3.0)
+        c, s = np.cos(angle), np.sin(angle)
+        turn = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        loads.append(Load(name=f"case-{k}", force=size * turn @ base.force,
+                          point=turn @ base.point, torque=size * base.torque))  # fmt: skip
+    return dataclasses.replace(problem, contacts=contacts, loads=tuple(loads), objective="check")
+
+
+def _assert_same_plans(plan, reference):
+    assert plan.status == reference.status
+    assert plan.solver == reference.solver
+    assert plan.warnings == reference.warnings
+    assert plan.safety_factors == reference.safety_factors
+    assert plan.held_intervals == reference.held_intervals
+    assert plan.held == reference.held
+    np.testing.assert_array_equal(plan.normal_forces, reference.normal_forces)
+    np.testing.assert_array_equal(plan.contact_wrenches, reference.contact_wrenches)
+    for name in plan.load_names:
+        motion, expected = plan.motions[name], reference.motions[name]
+        assert (motion is None) == (expected is None)
+        if motion is not None:
+            np.testing.assert_array_equal(motion.twist, expected.twist)
+
+
+def test_the_lane_gives_the_plan_of_one_block_per_case(block_path, lane_used):
+    # The same parameter vectors and the same simplex in the same order of cases: the same
+    # numbers to the last bit, for loads of sizes 0.2 to 3 (several force units).
+    problem = _turned_fixture_321(40)
+    plan = Planner(problem).solve()
+    assert 40 in lane_used
+    assert "dual simplex (direct)" in plan.solver
+    reference = block_path(problem)
+    _assert_same_plans(plan, reference)
+    assert not all(plan.held.values()) and any(plan.held.values())
+
+
+def _pushed_block() -> Problem:
+    """A block on three supports, pushed along +x by a frictionless clamp of 10 N: friction
+    (mu 0.3 of 9.8 N) cannot hold that alone, so a case is held only where its load pushes
+    back (along -x) enough and not too much; a load along +x is held at no multiple."""
+    supports = [
+        Contact(name=f"pad-{k}", role="support", position=[x, y, 0.0], normal=[0.0, 0.0, 1.0],
+                mu=0.3, model="point-pyramid", facets=8, inscribed=False)
+        for k, (x, y) in enumerate([(-0.03, -0.03), (0.03, -0.03), (0.0, 0.04)])
+    ]  # fmt: skip
+    clamp = Contact(name="pusher", role="clamp", position=[-0.05, 0.0, 0.01],
+                    normal=[1.0, 0.0, 0.0], mu=0.0, model="point-pyramid", facets=8,
+                    force=10.0)  # fmt: skip
+    loads = [
+        Load(name=f"{sign}{size:g}", force=[float(f"{sign}1") * size, 0.0, 0.0],
+             point=[0.05, 0.0, 0.01])
+        for sign, size in (("-", 10.0), ("-", 8.0), ("+", 5.0), ("-", 14.0), ("-", 9.0))
+    ]  # fmt: skip
+    return Problem(body=Body(mass=1.0, center_of_mass=[0.0, 0.0, 0.01]),
+                   contacts=(*supports, clamp), loads=tuple(loads), objective="check")  # fmt: skip
+
+
+def test_a_case_held_at_no_multiple_makes_the_check_infeasible_as_on_the_block_path(
+    block_path, lane_used
+):
+    problem = _pushed_block()
+    planner = Planner(problem)
+    for _ in range(3):  # the direct solver exists from the second solve on
+        plan = planner.solve()
+    assert 5 in lane_used
+    assert plan.status == "infeasible"
+    reference = block_path(problem)
+    assert reference.status == "infeasible"
+    assert plan.certificate == reference.certificate
+    for name in problem.loads[0:2]:
+        assert (plan.infeasible_motions or {}).get(name.name) is None
+
+
+def test_the_pushed_block_without_its_unheld_case_has_the_closed_form_intervals(block_path):
+    # The clamp's 10 N against friction of mu (9.8 N + 0) and the task load k F along -x: held
+    # while |10 - k F| <= 0.3 * 9.80665 N (the supports' pyramids have 8 facets, so their
+    # friction along x is mu times the normal force exactly).
+    problem = _pushed_block()
+    problem = dataclasses.replace(problem, loads=[x for x in problem.loads if x.name[0] == "-"])
+    plan = Planner(problem).solve()
+    reference = block_path(problem)
+    _assert_same_plans(plan, reference)
+    friction = 0.3 * 9.81
+    for load in problem.loads:
+        size = -load.force[0]
+        low, high = plan.held_intervals[load.name]
+        assert low == pytest.approx((10.0 - friction) / size, rel=1e-7)
+        assert high == pytest.approx((10.0 + friction) / size, rel=1e-7)
