@@ -195,3 +195,29 @@ def test_a_linear_check_of_many_cases_equals_each_case_solved_alone():
         assert high == pytest.approx(alone_high, rel=1e-7)
         assert low == pytest.approx(alone_low, abs=1e-7)
         assert plan.held[load.name] == alone.held[load.name]
+
+
+def test_a_basis_inverse_follows_a_changed_column_as_a_fresh_inverse_does():
+    # Sherman-Morrison on the one column that changed, against numpy's inverse of the new
+    # basis; a second changed column, or REFACTOR_EVERY updates in a row, invert afresh.
+    from fixplan.planner.dual_simplex import REFACTOR_EVERY
+
+    rng = np.random.default_rng(3)
+    n = 12
+    a = rng.normal(size=(3 * n, n))
+    rows = rng.choice(3 * n, n, replace=False)
+    inverse = np.linalg.inv(a[rows])
+    updates = 0
+    for step in range(REFACTOR_EVERY + 3):
+        changed = a.copy()
+        changed[:, step % n] += 0.3 * rng.normal(size=3 * n)
+        expected = np.linalg.inv(changed[rows])
+        updates_after = DualSimplex._refactored(changed, a, rows, inverse, updates)
+        assert updates_after == (updates + 1 if updates < REFACTOR_EVERY else 0)
+        np.testing.assert_allclose(inverse, expected, rtol=0, atol=1e-9 * np.abs(expected).max())
+        a, updates = changed, updates_after
+    two = a.copy()
+    two[:, :2] += 1.0
+    assert DualSimplex._refactored(two, a, rows, inverse, 0) == 0
+    np.testing.assert_allclose(inverse @ two[rows], np.eye(n), atol=1e-9)
+    assert DualSimplex._refactored(a, a.copy(), rows, inverse, 5) == 5  # (the same values)

@@ -46,6 +46,9 @@ MAX_MISS_RATE, WARM_TRIAL = 0.25, 8
 #: The basis inverse is computed afresh after this many rank-one updates, and an optimum found
 #: after at least ``CONFIRM_AFTER`` of them is confirmed on a fresh one.
 REFACTOR_EVERY, CONFIRM_AFTER = 32, 8
+#: A column update of the basis inverse whose Sherman-Morrison denominator ``1 + (B^-1 u)_c``
+#: is this small (a nearly singular new basis) is left to a fresh inversion.
+SHERMAN_MORRISON_MIN = 1e-6
 
 
 class DualSimplex:
@@ -65,8 +68,9 @@ class DualSimplex:
     def __init__(self, equalities: int, *, changing: bool = False):
         self._equalities = int(equalities)
         self._changing = changing
-        #: By objective: the basis, its inverse and the A it inverts.
-        self._bases: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        #: By objective: the basis, its inverse, the A it inverts and the column updates of that
+        #: inverse since it was last computed afresh (see :meth:`_refactored`).
+        self._bases: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray, int]] = {}
         self._record: dict[bytes, tuple[int, int]] = {}  # warm starts tried and missed
         #: Pivots of the last solve.
         self.pivots = 0
@@ -82,22 +86,43 @@ class DualSimplex:
             return None
         self.pivots = 0
         found = None
+        updates = 0
         if key in self._bases:
-            rows, inverse, inverted = self._bases[key]
+            rows, inverse, inverted, updates = self._bases[key]
             rows, inverse = rows.copy(), inverse.copy()
-            if inverted is a or np.array_equal(a, inverted) or _INVERT(a, rows, inverse):
+            updates = self._refactored(a, inverted, rows, inverse, updates)
+            if updates is not None:
                 found = self._pivot(a, q, b, rows, inverse)
             if self._changing:
                 self._record[key] = (tried + 1, missed + (found is None))
         if found is None:
-            found = self._cold(a, q, b)
+            found, updates = self._cold(a, q, b), 0
         if found is None:
             return None
         x, z, rows, inverse = found
         if len(self._bases) >= 8 and key not in self._bases:
             self._bases.clear()
-        self._bases[key] = (rows, inverse, a)
+        self._bases[key] = (rows, inverse, a, updates)
         return x, z
+
+    @staticmethod
+    def _refactored(a, inverted, rows, inverse, updates) -> int | None:
+        """Make ``inverse`` (that of ``inverted[rows]``) the inverse of ``a[rows]``; the column
+        updates since it was computed afresh, or ``None`` for a singular basis.
+
+        Where one column changed (the load column of a fixed-force objective, or of its scaled
+        form), by the rank-one update of Sherman and Morrison in ``O(n^2)``, at most
+        ``REFACTOR_EVERY`` times in a row; else by a fresh inversion in ``O(n^3)``."""
+        if inverted is a:
+            return updates
+        changed = _UPDATE(
+            a, inverted, rows, inverse, SHERMAN_MORRISON_MIN, updates < REFACTOR_EVERY
+        )
+        if changed == 0:
+            return updates
+        if changed == 1:
+            return updates + 1
+        return 0 if _INVERT(a, rows, inverse) else None
 
     def _cold(self, a, q, b):
         """From the artificial basis: ``a`` with the rows ``x_i <= BOUND`` (``m + i``) and
@@ -283,5 +308,41 @@ def invert(a, rows, inverse):  # pragma: no cover - compiled
     return True
 
 
+def column_update(a, inverted, rows, inverse, smallest, allowed):  # pragma: no cover - compiled
+    """Update ``inverse`` (that of ``inverted[rows]``) to that of ``a[rows]`` where the two
+    differ in one column ``c`` (by ``u`` on the basis rows): ``B^-1 - B^-1 u (B^-1)_c /
+    (1 + (B^-1 u)_c)``, if ``allowed`` and the denominator exceeds ``smallest``. Returns 0 (the
+    same matrix), 1 (updated) or -1 (not: more columns changed, or not allowed, or too small)."""
+    m, n = a.shape
+    column = -1
+    for j in range(n):
+        for i in range(m):
+            if a[i, j] != inverted[i, j]:
+                if column >= 0:
+                    return -1
+                column = j
+                break
+    if column < 0:
+        return 0
+    if not allowed:
+        return -1
+    shift = np.zeros(n)
+    for j in range(n):
+        total = 0.0
+        for k in range(n):
+            total += inverse[j, k] * (a[rows[k], column] - inverted[rows[k], column])
+        shift[j] = total
+    denominator = 1.0 + shift[column]
+    if abs(denominator) <= smallest:
+        return -1
+    for k in range(n):
+        factor = inverse[column, k] / denominator
+        if factor != 0.0:
+            for j in range(n):
+                inverse[j, k] -= shift[j] * factor
+    return 1
+
+
 _INVERT = compiled_scalar(invert)
+_UPDATE = compiled_scalar(column_update)
 _PIVOTS = compiled_scalar(dual_pivots)

@@ -261,9 +261,10 @@ class Runner:
                 solvers.append(result["solver"])
                 set_in = None  # (that path set the parameters)
             else:
-                normal[:, j] = normal_forces(stacked, values)[:, 0] * unit
-                friction[:, j] = values[stacked.friction.id][:, 0] * unit
-                scale[j] = values[stacked.scale.id][0]
+                answer = _values(stacked, values)
+                normal[:, j] = answer["normal"][:, 0] * unit
+                friction[:, j] = answer["friction"][:, 0] * unit
+                scale[j] = answer["scale"][0]
                 dual[:, j] = direct.dual(stacked.balance)[:, 0] / unit
                 solvers.append(f"{direct.method} (direct)")
             if progress is not None:
@@ -509,13 +510,15 @@ class Runner:
         return True
 
     def _direct_result(self, key: tuple, stacked: Stacked) -> dict | None:
-        """Solve straight through Clarabel when a direct solver exists for ``key``."""
-        if not self._direct_into(key, stacked):
+        """Solve straight through Clarabel when a direct solver exists for ``key`` (the answer
+        read from the solution, not through the cvxpy variables)."""
+        direct = self._direct.get(key)
+        values = None if direct is None else direct.solve()
+        if values is None:
             return None
-        dual = np.asarray(stacked.balance.dual_value, dtype=float)
-        solver = f"{self._direct[key].method} (direct)"
+        solver = f"{direct.method} (direct)"
         return {"status": "optimal", "solver": solver, "warnings": [],
-                **_values(stacked), "dual": dual}  # fmt: skip
+                **_values(stacked, values), "dual": direct.dual(stacked.balance)}  # fmt: skip
 
     def _prepare_direct(self, key: tuple, stacked: Stacked) -> None:
         """Build the direct solver of an objective after its second cvxpy solve.
@@ -598,11 +601,20 @@ def _in_newtons(result: dict, unit: float, objective: str) -> dict:
     return result
 
 
-def _values(stacked: Stacked) -> dict:
+def _values(stacked: Stacked, solved: dict | None = None) -> dict:
+    """Normal forces, friction loads and multiples of the last solve: from the cvxpy variables,
+    or from the direct solver's values by variable id (``solved``)."""
+    if solved is None:
+        friction, scale = stacked.friction.value, stacked.scale.value
+    else:
+        friction = solved[stacked.friction.id]
+        scale = stacked.scale.value  # (a constant for force objectives)
+        if isinstance(stacked.scale, cp.Variable):
+            scale = solved[stacked.scale.id]
     return {
-        "normal": normal_forces(stacked),
-        "friction": np.asarray(stacked.friction.value, dtype=float),
-        "scale": np.ravel(stacked.scale.value).astype(float),
+        "normal": normal_forces(stacked, solved),
+        "friction": np.asarray(friction, dtype=float),
+        "scale": np.ravel(scale).astype(float),
     }
 
 
