@@ -56,7 +56,7 @@ def analyse_cases(
         moving = np.flatnonzero(np.isfinite(k_max) & dual.any(axis=0))
         twists = staying(dual[:, moving], normal[:, moving])
         # Towards the task load: the dual's sign is the solver's choice.
-        twists *= np.where(np.sum(wrenches[:, moving] * twists, axis=0) >= 0.0, 1.0, -1.0)
+        twists *= np.where((wrenches[:, moving] * twists).sum(axis=0) >= 0.0, 1.0, -1.0)
         for j, twist in zip(moving, twists.T, strict=True):
             if twist.any():
                 motions[names[j]] = Screw.from_twist(twist, length_scale)
@@ -117,7 +117,7 @@ class StayingInContact:
             given = out[:, cases]
             projected = projection @ given
             # Kept where at least half the motion (in norm) remains: squared, a quarter.
-            kept = np.sum(projected * projected, axis=0) >= 0.25 * np.sum(given * given, axis=0)
+            kept = (projected * projected).sum(axis=0) >= 0.25 * (given * given).sum(axis=0)
             out[:, np.asarray(cases)[kept]] = projected[:, kept]
         return out
 

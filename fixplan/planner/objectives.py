@@ -45,11 +45,10 @@ def objective_value(objective: str, forces: dict, roles: dict, scale: np.ndarray
     for the fixed-force objectives the smallest task-load multiple ``scale``."""
     if objective in FIXED_FORCE_OBJECTIVES:
         return float(scale.min())
-    clamp = sum(v for k, v in forces.items() if roles[k] == "clamp")
-    fingers = [v for k, v in forces.items() if roles[k] == "finger"]
-    finger_total = np.sum(fingers, axis=0) if fingers else 0.0
     if objective == "min-total-clamp-force":
-        return float(clamp + np.max(finger_total))
+        clamp = sum(v for k, v in forces.items() if roles[k] == "clamp")
+        fingers = [v for k, v in forces.items() if roles[k] == "finger"]
+        return float(clamp + (np.max(np.sum(fingers, axis=0)) if fingers else 0.0))
     per_case = [np.broadcast_to(v, scale.shape) for v in forces.values()]
     if objective == "min-max-normal-force":
         return float(np.max(per_case))

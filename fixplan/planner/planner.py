@@ -89,6 +89,9 @@ class Planner:
         spread = np.linalg.norm(positions - problem.body.center_of_mass, axis=1)
         self.length_scale = float(max(spread.max(), 1e-3))
         self._passive = np.array([c.role in PASSIVE_ROLES for c in problem.contacts])
+        free = [(i, c.role) for i, c in enumerate(problem.contacts) if c.force is None]
+        self._free_clamps = [i for i, role in free if role == "clamp"]
+        self._free_fingers = [i for i, role in free if role == "finger"]
         # Where each row of the stacked friction loads goes in the contact wrenches of a plan.
         self._friction_owner = np.concatenate(
             [np.full(part.stop - part.start, i) for i, part in enumerate(self.layout.slices)]
@@ -210,10 +213,10 @@ class Planner:
 
     def _switched_off(self, disabled: Sequence[str]) -> np.ndarray | None:
         """``(C,)`` bool of the contacts named in ``disabled`` (``None`` for none)."""
-        names = [c.name for c in self.problem.contacts]
         disabled = tuple(disabled)
         if not disabled:
             return None
+        names = [c.name for c in self.problem.contacts]
         if not self.switchable:
             raise InvalidArgumentError("disabled needs a planner built with switchable=True")
         unknown = sorted(set(disabled) - set(names))
@@ -228,13 +231,10 @@ class Planner:
         critical value (the objective is flat there). With the clamp forces it found given,
         the cases are independent and each case's finger forces are minimised on their own.
         """
-        contacts = self.problem.contacts
-        free_clamps = [i for i, c in enumerate(contacts) if c.role == "clamp" and c.force is None]
-        free_fingers = [i for i, c in enumerate(contacts) if c.role == "finger" and c.force is None]
-        if objective in FIXED_FORCE_OBJECTIVES or not free_clamps or not free_fingers:
+        if objective in FIXED_FORCE_OBJECTIVES or not self._free_clamps or not self._free_fingers:
             return result
         fixed = dict(given)
-        fixed.update({i: float(result["normal"][i, 0]) for i in free_clamps})
+        fixed.update({i: float(result["normal"][i, 0]) for i in self._free_clamps})
         refined = self._squeeze_free(
             objective + REFINE, wrenches, fixed, squeezed, disabled=disabled
         )

@@ -274,6 +274,8 @@ class Load:
     acceleration: np.ndarray = field(default_factory=lambda: np.zeros(3))
     angular_velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))
     angular_acceleration: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    _wrench: np.ndarray = field(init=False, repr=False, compare=False)
+    _moves: bool = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         where = f"load {self.name!r}" if isinstance(self.name, str) else "load"
@@ -289,6 +291,15 @@ class Load:
         for key, (limit, units) in limits.items():
             value = _vector(f"{where}.{key}", getattr(self, key), limit=limit, units=units)
             object.__setattr__(self, key, value)
+        (x, y, z), (fx, fy, fz), (tx, ty, tz) = (
+            getattr(self, k).tolist() for k in ("point", "force", "torque")
+        )
+        wrench = np.array(
+            [fx, fy, fz, y * fz - z * fy + tx, z * fx - x * fz + ty, x * fy - y * fx + tz]
+        )
+        wrench.setflags(write=False)
+        object.__setattr__(self, "_wrench", wrench)
+        object.__setattr__(self, "_moves", bool(self.acceleration.any() or self.rotates))
 
     @property
     def rotates(self) -> bool:
@@ -297,13 +308,8 @@ class Load:
 
     @property
     def wrench(self) -> np.ndarray:
-        """``(force, moment about the world origin)`` [N, N m]."""
-        point, force, torque = self.point.tolist(), self.force.tolist(), self.torque.tolist()
-        (x, y, z), (fx, fy, fz), (tx, ty, tz) = point, force, torque
-        # The cross product written out in floats: np.cross costs more than the rest.
-        return np.array(
-            [fx, fy, fz, y * fz - z * fy + tx, z * fx - x * fz + ty, x * fy - y * fx + tz]
-        )
+        """``(force, moment about the world origin)`` [N, N m] (read-only)."""
+        return self._wrench
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -528,15 +534,14 @@ class Problem:
         problem's): each load's applied wrench plus the body's d'Alembert wrench of its motion
         (gravity is not included)."""
         loads = self.loads if loads is None else loads
-        columns = []
-        for load in loads:
-            wrench = load.wrench
-            if load.rotates or load.acceleration.any():
+        out = np.empty((6, len(loads)))
+        for j, load in enumerate(loads):
+            out[:, j] = load._wrench
+            if load._moves:
                 if load.rotates and self.body.inertia is None:
                     raise ProblemError(
                         f"load {load.name!r} has an angular velocity or acceleration: the body "
                         "needs an inertia tensor (body.inertia, body.size or a mesh)"
                     )
-                wrench = wrench + self.body.inertial_wrench(load)
-            columns.append(wrench)
-        return np.column_stack(columns)
+                out[:, j] += self.body.inertial_wrench(load)
+        return out

