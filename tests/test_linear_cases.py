@@ -1,5 +1,6 @@
 """The cases of a linear fixed-force objective, one by one straight through the direct solver
-(``Runner._one_by_one``), against the general path of one block per case."""
+(``Runner._one_by_one``), against the general path of one block per case; and the certificate
+of a case held at no multiple, against the conditions of Farkas's lemma."""
 
 import dataclasses
 from pathlib import Path
@@ -142,3 +143,25 @@ def test_the_pushed_block_without_its_unheld_case_has_the_closed_form_intervals(
         low, high = plan.held_intervals[load.name]
         assert low == pytest.approx((10.0 - friction) / size, rel=1e-7)
         assert high == pytest.approx((10.0 + friction) / size, rel=1e-7)
+
+
+def test_the_certificate_of_the_pushed_block_moves_it_the_way_the_clamp_pushes():
+    # A Farkas certificate: a twist that gravity and the given clamp force drive with positive
+    # power while every force the supports' cones allow does power >= 0 on it (it lifts the
+    # block off them, by the associated flow of Coulomb's cone). Its sign came from the task
+    # load and gravity alone, without the clamp: the block was said to move into its supports.
+    problem = _pushed_block()
+    plan = Planner(problem).solve()
+    assert plan.status == "infeasible"
+    twist = plan.infeasible_motions["+5"].twist
+    v, omega = twist[:3], twist[3:]
+    for contact in problem.contacts[:3]:  # the supports
+        velocity = v + np.cross(omega, contact.position)
+        assert velocity[2] >= 0.3 * np.cos(np.pi / 8) * np.hypot(*velocity[:2]) - 1e-7
+    clamp = problem.contacts[3]
+    clamp_force = clamp.force * clamp.normal  # pushing on the block along +x
+    at_clamp = v + np.cross(omega, clamp.position)
+    at_centre = v + np.cross(omega, problem.body.center_of_mass)
+    weight = problem.body.mass * np.array([0.0, 0.0, -9.81])
+    assert clamp_force @ at_clamp + weight @ at_centre > 0.0
+    assert at_centre[0] > 0.0

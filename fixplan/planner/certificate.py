@@ -1,7 +1,9 @@
 """Why a problem cannot be held: the unresisted motions of an infeasible problem, in words.
 
 The dual of the equilibrium constraints of an infeasible problem is a Farkas certificate: per
-load case a twist that the loads drive with positive power while no contact can resist it.
+load case a twist that the applied wrenches (gravity, given forces, task loads) drive with
+positive power while no contact can resist it: every force a contact's friction cone allows does
+power of its own sign on it (for Coulomb cones, that motion leaves the contacts).
 """
 
 from __future__ import annotations
@@ -13,25 +15,30 @@ from fixplan.planner.screw import Screw
 
 
 def certificate(
-    problem: Problem, dual: np.ndarray | None, wrenches: np.ndarray, *, fixed_forces: bool,
-    length_scale: float,
+    problem: Problem, dual: np.ndarray | None, wrenches: np.ndarray, applied: np.ndarray, *,
+    fixed_forces: bool, length_scale: float,
 ) -> tuple[dict, str]:  # fmt: skip
     """The unresisted motion of each load case that cannot be held, and the whole in words.
 
     ``dual`` ``(6, K)`` is the equilibrium dual of the infeasible solve (``None`` when the
-    solver gave none); ``fixed_forces``: the active forces were given (then no multiple of the
-    task load, not even 0, is held).
+    solver gave none); ``wrenches`` ``(6, K)`` are the task wrenches and ``applied`` ``(6, K)``
+    the wrenches that no contact of the program decides: gravity, the given active forces and,
+    for the force objectives, the task loads. The motion is the dual's direction in which they
+    do positive power (the solver's sign is its own); ``fixed_forces``: the active forces were
+    given (then no multiple of the task load, not even 0, is held).
     """
     if dual is None:
         return {}, "the problem is infeasible (the solver gave no certificate)"
     size = np.abs(dual).max()
-    gravity = problem.body.weight_wrench
     motions, lines = {}, []
     for j, load in enumerate(problem.loads):
         twist = dual[:, j]
         if size == 0.0 or np.abs(twist).max() <= 1e-6 * size:
             continue
-        twist = twist if (wrenches[:, j] + gravity) @ twist >= 0.0 else -twist
+        power = applied[:, j] @ twist
+        if abs(power) <= 1e-9 * np.abs(applied[:, j]).max(initial=0.0) * np.abs(twist).max():
+            power = wrenches[:, j] @ twist  # (nothing applied drives it: the task load does)
+        twist = twist if power >= 0.0 else -twist
         screw = Screw.from_twist(twist, length_scale)
         motions[load.name] = screw
         cause = (

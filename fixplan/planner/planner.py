@@ -162,9 +162,10 @@ class Planner:
         fields = {"load_names": names, "squeeze_contacts": self.squeeze_contacts}
         status = result["status"]
         if status == "infeasible":
+            fixed = objective in FIXED_FORCE_OBJECTIVES
             motions, words = certificate(
-                self.problem, result.get("dual"), wrenches,
-                fixed_forces=objective in FIXED_FORCE_OBJECTIVES, length_scale=self.length_scale,
+                self.problem, result.get("dual"), wrenches, self._applied(wrenches, given, fixed),
+                fixed_forces=fixed, length_scale=self.length_scale,
             )  # fmt: skip
             fields.update(certificate=words, infeasible_motions=motions)
         if status not in ("optimal", "inaccurate"):
@@ -286,6 +287,17 @@ class Planner:
         if progress is not None:
             progress(cases, cases)
         return {"status": "optimal", "scale": scale}
+
+    def _applied(self, wrenches, given, fixed_forces: bool) -> np.ndarray:
+        """The wrenches ``(6, K)`` that no contact of the program decides: gravity, the
+        ``given`` normal forces and, unless the forces are fixed (then the task load's multiple
+        is decided), the task ``wrenches``."""
+        cases = wrenches.shape[1]
+        applied = np.zeros((6, cases)) if fixed_forces else np.array(wrenches, dtype=float)
+        applied += self.problem.body.weight_wrench[:, None]
+        for i, force in given.items():
+            applied += self.layout.normal_map[:, i, None] * np.broadcast_to(force, (cases,))
+        return applied
 
     # -- reporting ----------------------------------------------------------------------------
 
