@@ -165,3 +165,61 @@ def test_the_certificate_of_the_pushed_block_moves_it_the_way_the_clamp_pushes()
     weight = problem.body.mass * np.array([0.0, 0.0, -9.81])
     assert clamp_force @ at_clamp + weight @ at_centre > 0.0
     assert at_centre[0] > 0.0
+
+
+def _counted_plans(monkeypatch, problem, later, *, lane):
+    """Two plans of ``problem`` and one with the ``later`` loads by one planner, with the
+    direct solves of each (the lane declined unless ``lane``)."""
+    from fixplan.planner.direct_solve import DirectSolver
+
+    calls = [0]
+    solve = DirectSolver.solve
+
+    def counted(self, **options):
+        calls[0] += 1
+        return solve(self, **options)
+
+    plans, counts = [], []
+    with monkeypatch.context() as patch:
+        patch.setattr(DirectSolver, "solve", counted)
+        if not lane:
+            patch.setattr(Runner, "_one_by_one", lambda self, *args: None)
+        planner = Planner(problem)
+        for loads in (None, None, later):
+            calls[0] = 0
+            plans.append(planner.solve(loads))
+            counts.append(calls[0])
+    return plans, counts
+
+
+def test_a_case_the_direct_solver_fails_on_is_not_given_to_it_twice(monkeypatch, lane_used):
+    # Every fifth case pushes along +x (held at no multiple): the direct solver fails on it and
+    # cvxpy gives the certificate. The lane must hand such a case to the block path without
+    # that path trying the direct solver on it once more: each try counts as a missed warm
+    # start of the simplex, and with more of them the simplex gives up on the objective sooner
+    # than on the block path (Clarabel then for every later case of the planner, and other
+    # numbers in the last bits). The same direct solves as the block path, the same plans.
+    base = _pushed_block()
+    sizes = np.linspace(7.0, 13.0, 40)
+    sideways = np.linspace(-0.5, 0.5, 40)[::-1]
+    loads = [
+        Load(name=f"case-{k}", force=[(1.0 if k % 5 == 4 else -1.0) * size, y, 0.0],
+             point=[0.05, 0.0, 0.01])
+        for k, (size, y) in enumerate(zip(sizes, sideways, strict=True))
+    ]  # fmt: skip
+    held = [dataclasses.replace(load, force=[-abs(load.force[0]), *load.force[1:]])
+            for load in loads]  # fmt: skip
+    problem = dataclasses.replace(base, loads=tuple(loads))
+    plans, counts = _counted_plans(monkeypatch, problem, held, lane=True)
+    assert 40 in lane_used
+    references, reference_counts = _counted_plans(monkeypatch, problem, held, lane=False)
+    assert [plan.status for plan in plans] == ["infeasible", "infeasible", "optimal"]
+    for plan, reference in zip(plans[:2], references[:2], strict=True):
+        assert plan.solver == reference.solver
+        assert plan.certificate == reference.certificate
+        motions, expected = plan.infeasible_motions, reference.infeasible_motions
+        assert motions.keys() == expected.keys()
+        for name, motion in motions.items():
+            np.testing.assert_array_equal(motion.twist, expected[name].twist)
+    _assert_same_plans(plans[2], references[2])
+    assert counts == reference_counts

@@ -230,8 +230,10 @@ class Runner:
         through the direct solver with its parameter vector written here: the given forces set
         once per force unit, only the task wrench per case. (The path of :meth:`_run_block`
         costs about 200 µs of Python per case around a simplex of 50 µs.) A case the direct
-        solver does not solve, and those before it exists, take that path. ``None`` where the
-        given forces differ between cases (that path then takes them all)."""
+        solver does not solve, and those before it exists, take that path (a case the direct
+        solver failed on without trying it again: a second try would count as a second missed
+        warm start of the simplex). ``None`` where the given forces differ between cases (that
+        path then takes them all)."""
         if not all(isinstance(value, float) for value in given.values()):
             return None
         key = (objective, False)
@@ -256,6 +258,7 @@ class Runner:
                 result = self._run_block(
                     objective, *_block_of(order[position : position + 1], 1, wrenches, given,
                                           None, numbers), sense, False, disabled,
+                    direct_failed=direct is not None,
                 )  # fmt: skip
                 results.append((result, j))
                 solvers.append(result["solver"])
@@ -287,8 +290,9 @@ class Runner:
         return {name: value for name, value in merged.items() if name not in missing}
 
     def _run_block(
-        self, objective, wrenches, given, unloaded, numbers, sense, accurate, disabled
-    ) -> dict:
+        self, objective, wrenches, given, unloaded, numbers, sense, accurate, disabled,
+        direct_failed=False,
+    ) -> dict:  # fmt: skip
         """One block (its load cases ``numbers`` among the problem's), and again for the cases
         whose largest multiple shared it with cases at the cap ``MAX_SAFETY_FACTOR``.
 
@@ -297,13 +301,14 @@ class Runner:
         multiple with a friction margin of 1e-4 came out held to 0.497, reported optimal.
 
         A fixed-force block that Clarabel does not solve is solved case by case
-        (:meth:`_case_by_case`) rather than by the fallback solver."""
+        (:meth:`_case_by_case`) rather than by the fallback solver. ``direct_failed``: the
+        direct solver has just failed on this block's parameters (see :meth:`_solve_block`)."""
         separable = (
             objective in FIXED_FORCE_OBJECTIVES and len(numbers) > 1 and np.unique(numbers).size > 1
         )
         result = self._solve_block(
             objective, wrenches, given, unloaded, numbers, sense, accurate, disabled,
-            fallback=not separable,
+            fallback=not separable, direct_failed=direct_failed,
         )  # fmt: skip
         if separable and result["status"] in ("solver-error", "inaccurate"):
             return self._case_by_case(
@@ -375,10 +380,13 @@ class Runner:
         accurate,
         disabled,
         fallback=True,
+        direct_failed=False,
     ) -> dict:
         """One block: with osculating ellipsoids first where they apply, else (or where their
         rounds do not settle) with cutting planes or no exact models at all; without
-        ``fallback``, a solver failure is returned as it is (no retry with another solver)."""
+        ``fallback``, a solver failure is returned as it is (no retry with another solver);
+        with ``direct_failed`` (the direct solver failed on these parameters just before),
+        straight to the solve that :meth:`_direct_result` would have preceded."""
         unit = self._force_unit(wrenches, given)
         for osculating in (True, False) if self.osculating else (False,):
             key = (objective, osculating)
@@ -386,7 +394,8 @@ class Runner:
             self._set_parameters(key, stacked, wrenches / unit, given, sense, unloaded, disabled,
                                  unit)  # fmt: skip
             exact = stacked.exact is not None  # rounds follow every solve
-            direct = None if accurate or exact else self._direct_result(key, stacked)
+            skip = accurate or exact or (direct_failed and not osculating)
+            direct = None if skip else self._direct_result(key, stacked)
             if direct is not None:
                 return _in_newtons(direct, unit, objective)
             if osculating:
