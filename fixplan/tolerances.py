@@ -42,9 +42,14 @@ EXACT_CUT_RTOL = 1e-9
 #: problems badly scaled (reactions a million times the loads).
 MAX_SAFETY_FACTOR = 1e3
 
-#: A multiple within this fraction of ``MAX_SAFETY_FACTOR`` counts as at the cap: inaccurate
-#: answers (SCS) leave capped cases at 999.75 to 1039, so 999 and up are reported infinite.
-CAP_RTOL = 1e-3
+#: A largest multiple within this fraction of ``MAX_SAFETY_FACTOR`` is reported as at the cap
+#: (infinite): the solver's accuracy.
+CAP_RTOL = 1e-6
+
+#: A case of a block whose largest multiple is within this fraction of ``MAX_SAFETY_FACTOR``
+#: counts as carried at the cap when its block mates are solved again without it (see
+#: :mod:`fixplan.planner.runner`): inaccurate answers leave capped cases at 999.75 to 1039.
+CAPPED_BLOCK_RTOL = 1e-3
 
 #: Smallest eigenvalue of a fitted ellipsoid's matrix in normalised coordinates: keeps the fit
 #: positive definite (a bounded set) when the data leave a direction unconstrained.

@@ -40,6 +40,7 @@ from fixplan.models.exact import Exact
 from fixplan.planner.exact_contacts import ExactContacts
 from fixplan.planner.parameters import assign
 from fixplan.tolerances import (
+    CAP_RTOL,
     EXACT_CUT_RTOL,
     FRICTION_SET_RTOL,
     MAX_SAFETY_FACTOR,
@@ -215,7 +216,9 @@ class OsculatingPool(ExactContacts):
             return sizes / max(float(sizes.max(initial=0.0)), FORCE_DUAL_FLOOR)
         weights = sizes / np.maximum(sizes.max(axis=0, initial=0.0), 1e-300)
         multiples = np.asarray(self._scale.value, dtype=float)
-        weights[:, (multiples <= MULTIPLE_ATOL) | (multiples >= MAX_SAFETY_FACTOR * (1 - 1e-6))] = 0
+        weights[
+            :, (multiples <= MULTIPLE_ATOL) | (multiples >= MAX_SAFETY_FACTOR * (1 - CAP_RTOL))
+        ] = 0
         return weights
 
     def _reach(self, twists: np.ndarray, weights: np.ndarray, idle: np.ndarray) -> bool:

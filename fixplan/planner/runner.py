@@ -6,7 +6,8 @@ their load cases (independent, since the active forces are given) in blocks of
 solve all cases at once. A compiled problem is re-solved straight through Clarabel once cvxpy
 has solved it twice (:mod:`fixplan.planner.direct_solve`): re-solves of a force objective with
 new loads, and the blocks of a fixed-force objective after the second. A solver failure retries
-once with a fallback solver.
+once with a fallback solver; a fixed-force block of several load cases is solved case by case
+instead (the fallback, SCS, is far less accurate).
 
 Every block is solved in a force unit of its own, a power of two (which divides without
 rounding) that puts its largest force (the components of the task forces, of the task torques
@@ -39,7 +40,7 @@ from fixplan.planner.stacking import (
     set_given,
     set_units,
 )
-from fixplan.tolerances import CAP_RTOL, MAX_SAFETY_FACTOR
+from fixplan.tolerances import CAPPED_BLOCK_RTOL, MAX_SAFETY_FACTOR
 
 SOLVERS = ("CLARABEL", "OSQP", "SCS")
 
@@ -252,7 +253,8 @@ class Runner:
                     self._set_parameters(key, stacked, wrenches[:, j : j + 1] / unit, given,
                                          sense, None, disabled, unit)  # fmt: skip
                     vector, set_in = direct.parameter_vector(), unit
-                vector[direct.entries(stacked.task)] = wrenches[:, j] / unit
+                    task = direct.entries(stacked.task)
+                vector[task] = wrenches[:, j] / unit
                 values = direct.solve(vector=vector)
             if values is None:
                 result = self._run_block(
@@ -320,7 +322,7 @@ class Runner:
             or result["status"] not in ("optimal", "inaccurate")
         ):
             return result
-        capped = result["scale"] >= MAX_SAFETY_FACTOR * (1.0 - CAP_RTOL)
+        capped = result["scale"] >= MAX_SAFETY_FACTOR * (1.0 - CAPPED_BLOCK_RTOL)
         again = np.flatnonzero(~capped)
         if not capped.any() or again.size == 0:
             return result
@@ -328,10 +330,13 @@ class Runner:
         # only without its capped block mates, and then blurs the others in turn); not where
         # only copies of a case reached the cap (padding), which would repeat the same block.
         fewer = np.unique(numbers[again]).size < np.unique(numbers).size
-        redo = (self._run_block if fewer else self._solve_block)(
-            objective, *_block_of(again, len(numbers), wrenches, given, unloaded, numbers),
-            sense, accurate, disabled,
-        )  # fmt: skip
+        block = _block_of(again, len(numbers), wrenches, given, unloaded, numbers)
+        if fewer:
+            redo = self._run_block(objective, *block, sense, accurate, disabled)
+        else:
+            redo = self._solve_block(objective, *block, sense, accurate, disabled, fallback=False)
+            if redo["status"] in ("solver-error", "inaccurate"):
+                redo = self._case_by_case(objective, *block, sense, accurate, disabled, redo)
         if redo["status"] not in ("optimal", "inaccurate"):
             return result
         for key in ("normal", "friction", "scale", "dual", "known_use"):
@@ -366,7 +371,7 @@ class Runner:
             f"{failed['solver']} returned {failed['status']} on a block of {first.size} load "
             "cases; solved them one by one"
         )
-        merged["warnings"] = [note, *merged["warnings"]]
+        merged["warnings"] = list(dict.fromkeys([*failed["warnings"], note, *merged["warnings"]]))
         return merged
 
     def _solve_block(
@@ -394,15 +399,20 @@ class Runner:
             self._set_parameters(key, stacked, wrenches / unit, given, sense, unloaded, disabled,
                                  unit)  # fmt: skip
             exact = stacked.exact is not None  # rounds follow every solve
-            skip = accurate or exact or (direct_failed and not osculating)
-            direct = None if skip else self._direct_result(key, stacked)
-            if direct is not None:
-                return _in_newtons(direct, unit, objective)
+            # One try of the direct solver per block: each failed try of its simplex counts as
+            # a missed warm start (see :mod:`fixplan.planner.dual_simplex`).
+            tried = direct_failed and not osculating
+            if not (accurate or exact or tried):
+                direct = self._direct_result(key, stacked)
+                if direct is not None:
+                    return _in_newtons(direct, unit, objective)
+                tried = key in self._direct
             if osculating:
                 cases = [(objective, sense, n, wrenches[:, j]) for j, n in enumerate(numbers)]
                 stacked.exact.place([self._start(*case) for case in cases])
             notes = []
-            status, settled = self._solve(key, stacked, self.solver, accurate, notes)
+            status, settled = self._solve(key, stacked, self.solver, accurate, notes,
+                                          direct_first=not tried)  # fmt: skip
             if osculating:
                 self._remember(cases, stacked.exact.ellipsoids)
                 if not settled:
@@ -415,9 +425,8 @@ class Runner:
             if status in ("solver-error", "inaccurate") and not fallback:
                 return {"status": status, "solver": solver, "warnings": notes}
             if status in ("solver-error", "inaccurate"):
-                fallback = _FALLBACK[solver]
-                notes.append(f"{solver} returned {status}; retried with {fallback}")
-                solver = fallback
+                notes.append(f"{solver} returned {status}; retried with {_FALLBACK[solver]}")
+                solver = _FALLBACK[solver]
                 status, _ = self._solve(key, stacked, solver, False, notes)
             if exact:
                 solver = f"{solver} (cutting planes)"
@@ -483,13 +492,19 @@ class Runner:
             result["dual"] = None if dual is None else np.asarray(dual, dtype=float)
         return result
 
-    def _solve(self, key, stacked: Stacked, solver: str, accurate: bool, notes) -> tuple:
+    def _solve(
+        self, key, stacked: Stacked, solver: str, accurate: bool, notes, *, direct_first=True
+    ) -> tuple:
         """Solve ``stacked``, with the rounds of its exact contacts (notes are appended); each
-        solve goes through Clarabel directly once a direct solver exists. Returns the status
-        and whether the rounds settled (always, but for osculating ellipsoids)."""
+        solve goes through Clarabel directly once a direct solver exists (the first only with
+        ``direct_first``: not where the direct solver just failed). Returns the status and
+        whether the rounds settled (always, but for osculating ellipsoids)."""
+        direct = direct_first
 
         def once() -> str:
-            if not accurate and solver == self.solver and self._direct_into(key, stacked):
+            nonlocal direct
+            use, direct = direct and not accurate and solver == self.solver, True
+            if use and self._direct_into(key, stacked):
                 return "optimal"
             status = _call(stacked.problem, solver, accurate=accurate)
             if status == "optimal" and solver == self.solver:
