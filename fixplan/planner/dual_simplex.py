@@ -72,6 +72,8 @@ class DualSimplex:
         #: inverse since it was last computed afresh (see :meth:`_refactored`).
         self._bases: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray, int]] = {}
         self._record: dict[bytes, tuple[int, int]] = {}  # warm starts tried and missed
+        #: The last matrix pivoted on, with its rows' 1- and 2-norms.
+        self._row_sizes: tuple = (None, None, None)
         #: Pivots of the last solve.
         self.pivots = 0
 
@@ -162,10 +164,15 @@ class DualSimplex:
         ``(x, z, rows, inverse)`` at the optimum, or ``None`` if they failed."""
         m, n = a.shape
         x, z = np.empty(n), np.zeros(m)
+        measured, size, norm = self._row_sizes
+        fresh = measured is not a  # (the same matrix object is never changed: see the class)
+        if fresh:
+            size, norm = np.empty(m), np.empty(m)
+            self._row_sizes = (a, size, norm)
         limit = MAX_PIVOTS_PER_ROW * (m + n)
         pivots = _PIVOTS(a, b, q, self._equalities, rows, inverse, x, z, limit,
                             FEASIBILITY_RTOL, OPTIMALITY_RTOL, REFACTOR_EVERY,
-                            CONFIRM_AFTER)  # fmt: skip
+                            CONFIRM_AFTER, size, norm, fresh)  # fmt: skip
         if pivots < 0:
             return None
         self.pivots += pivots
@@ -173,19 +180,20 @@ class DualSimplex:
 
 
 def dual_pivots(a, b, q, equalities, rows, inverse, x, z, limit, feasibility, optimality,
-                refactor, confirm):  # fmt: skip  # pragma: no cover - compiled
+                refactor, confirm, size, norm, fresh):  # fmt: skip  # pragma: no cover - compiled
     """Dual simplex pivots from the dual feasible basis ``rows`` (with ``inverse``, both
     updated in place) until its vertex ``x`` is feasible; ``z`` gets the multipliers. Returns
     the number of pivots, or -1 (infeasible program, too many pivots, multipliers < 0, a
-    singular basis)."""
+    singular basis). ``size`` and ``norm`` ``(m,)`` hold the rows' 1- and 2-norms (computed
+    here when ``fresh``)."""
     m, n = a.shape
-    size = np.zeros(m)
-    norm = np.zeros(m)
-    for i in range(m):
-        for j in range(n):
-            size[i] += abs(a[i, j])
-            norm[i] += a[i, j] * a[i, j]
-    norm = np.sqrt(norm)
+    if fresh:
+        for i in range(m):
+            size[i], norm[i] = 0.0, 0.0
+            for j in range(n):
+                size[i] += abs(a[i, j])
+                norm[i] += a[i, j] * a[i, j]
+            norm[i] = np.sqrt(norm[i])
     q_size = 0.0
     for j in range(n):
         q_size = max(q_size, abs(q[j]))

@@ -24,7 +24,7 @@ def part_values(parts: tuple, shape: tuple[int, int], solved: dict | None = None
     × 20 cases), where cvxpy evaluates the stacked expression in 28 µs."""
     out = np.zeros(shape)
     for index, piece in parts:
-        value = piece.value if solved is None else solved.get(piece.id, piece.value)
+        value = solved[piece.id] if solved is not None and piece.id in solved else piece.value
         values = np.asarray(value, dtype=float)
         out[index] = values if values.ndim == 2 else values[:, None]
     return out

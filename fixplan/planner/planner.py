@@ -89,6 +89,11 @@ class Planner:
         spread = np.linalg.norm(positions - problem.body.center_of_mass, axis=1)
         self.length_scale = float(max(spread.max(), 1e-3))
         self._passive = np.array([c.role in PASSIVE_ROLES for c in problem.contacts])
+        self._roles = {c.name: c.role for c in problem.contacts}  # (in the contacts' order)
+        #: The given normal forces [N] by contact index.
+        self._given_forces = {
+            i: c.force for i, c in enumerate(problem.contacts) if c.force is not None
+        }
         free = [(i, c.role) for i, c in enumerate(problem.contacts) if c.force is None]
         self._free_clamps = [i for i, role in free if role == "clamp"]
         self._free_fingers = [i for i, role in free if role == "finger"]
@@ -99,6 +104,7 @@ class Planner:
         self._friction_component = np.concatenate(
             [np.arange(1, 1 + part.stop - part.start) for part in self.layout.slices]
         ).astype(np.intp)
+        self._friction_places: dict[int, np.ndarray] = {}  # see _wrenches
         self._staying = StayingInContact(self.layout.normal_map, self._passive, self.length_scale)
         self._verify = Verifier(problem, self.layout, self.friction_use, self.length_scale)
         passive_map = self.layout.normal_map[:, self._passive]
@@ -147,11 +153,9 @@ class Planner:
         names = tuple(x.name for x in loads)
         wrenches = self.problem.task_wrenches(loads)
         off = self._switched_off(disabled)
-        given = {
-            i: 0.0 if off is not None and off[i] else c.force
-            for i, c in enumerate(self.problem.contacts)
-            if c.force is not None
-        }
+        given = dict(self._given_forces)
+        if off is not None:
+            given.update({i: 0.0 for i in given if off[i]})
         squeezed: dict[str, tuple[str, ...]] = {}
         result = self._squeeze_free(
             objective, wrenches, given, squeezed, progress=progress, disabled=off
@@ -199,8 +203,7 @@ class Planner:
                 extra = {}
         else:
             extra = {}
-        roles = {c.name: c.role for c in self.problem.contacts}
-        value = objective_value(objective, forces, roles, result["scale"])
+        value = objective_value(objective, forces, self._roles, result["scale"])
         if objective in FIXED_FORCE_OBJECTIVES and "safety_factor" in extra:
             value = extra["safety_factor"]
         notes += self._squeeze_notes(squeezed)
@@ -321,7 +324,7 @@ class Planner:
             status=status,
             objective=self.problem.objective,
             objective_value=value,
-            contact_names=tuple(c.name for c in self.problem.contacts),
+            contact_names=tuple(self._roles),
             solver=solver,
             solve_time=time.perf_counter() - start,
             warnings=tuple(notes),
@@ -329,10 +332,15 @@ class Planner:
         )
 
     def _wrenches(self, normal, friction) -> np.ndarray:
+        """The contact wrenches ``(C, K, 4)`` of ``normal`` ``(C, K)`` and ``friction``
+        ``(D, K)``, the friction loads placed by flat indices kept per ``K``."""
         contacts, cases = normal.shape
+        if cases not in self._friction_places:
+            owner, component = self._friction_owner[:, None], self._friction_component[:, None]
+            self._friction_places[cases] = (owner * cases + np.arange(cases)) * 4 + component
         out = np.zeros((contacts, cases, 4))
         out[:, :, 0] = normal
-        out[self._friction_owner, :, self._friction_component] = friction
+        out.reshape(-1)[self._friction_places[cases]] = friction
         return out
 
 

@@ -468,7 +468,7 @@ class Runner:
         if self._units.get(key) != unit:
             set_units(stacked, self.problem.body.weight_wrench, unit)
             self._units[key] = unit
-        scalars = tuple((i, float(v)) for i, v in given.items() if np.ndim(v) == 0)
+        scalars = tuple((i, v) for i, v in given.items() if isinstance(v, float))
         state = (unit, scalars) if len(scalars) == len(given) else None
         if state is None or self._given.get(key) != state:
             set_given(stacked, given, wrenches.shape[1], unit)  # (not again for the same forces)

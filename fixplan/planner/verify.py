@@ -55,7 +55,8 @@ class Verifier:
         _EQUILIBRIUM(*self._maps, normal, friction, wrenches, scale, self._gravity,
                      self._length_scale, sizes, ratios)  # fmt: skip
         problems = []
-        if ratios.max(initial=0.0) > EQUILIBRIUM_RTOL:
+        relative = float(ratios.max(initial=0.0))
+        if relative > EQUILIBRIUM_RTOL:
             for row, unit in ((0, "N"), (1, "N m")):
                 worst = int(np.argmax(ratios[row]))
                 ratio, size = ratios[row, worst], sizes[row, worst]
@@ -65,7 +66,6 @@ class Verifier:
                         f"{ratio * size:.3g} {unit}, over {EQUILIBRIUM_RTOL:g} of the "
                         f"wrenches involved ({size:.3g} {unit})"
                     )
-        relative = float(ratios.max(initial=0.0))
         known = answer.get("known_use")
         return relative, problems + self._friction_problems(normal, friction, known)
 
