@@ -286,6 +286,7 @@ class _Program:
         return vector
 
     def entries(self, parameter) -> slice:
+        """Where ``parameter``'s values sit in the parameter vector."""
         for known, column, size in self._columns:
             if known is parameter:
                 return slice(column, column + size)

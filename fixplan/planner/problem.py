@@ -291,6 +291,7 @@ class Load:
         for key, (limit, units) in limits.items():
             value = _vector(f"{where}.{key}", getattr(self, key), limit=limit, units=units)
             object.__setattr__(self, key, value)
+        # The wrench once, its cross product written out in floats (np.cross costs more).
         (x, y, z), (fx, fy, fz), (tx, ty, tz) = (
             getattr(self, k).tolist() for k in ("point", "force", "torque")
         )
