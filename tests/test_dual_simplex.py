@@ -163,10 +163,10 @@ def test_a_changing_program_whose_warm_starts_keep_missing_is_left_to_the_caller
     assert not any(answers[-10:])  # it stopped trying
 
 
-def test_a_linear_check_of_many_cases_equals_each_case_solved_alone():
-    # fixture-321 (pyramids) at its planned clamp forces, 30 turned load cases: solved one by
-    # one in an order of similar loads through the simplex (from the third solve on), and
-    # returned in the cases' own order.
+def turned_fixture_321(count: int, seed: int, sizes: tuple[float, float] | None = None) -> Problem:
+    """fixture-321 (pyramids) at its planned clamp forces (objective ``check``), its loads in
+    turn as ``count`` load cases, each turned about z at random (and scaled by a random factor
+    within ``sizes``)."""
     problem = load_problem(Path(__file__).resolve().parents[1] / "problems" / "fixture-321.toml")
     problem = problem.problem
     forces = Planner(problem).solve().forces
@@ -174,16 +174,25 @@ def test_a_linear_check_of_many_cases_equals_each_case_solved_alone():
         dataclasses.replace(c, force=float(forces[c.name])) if c.name in forces else c
         for c in problem.contacts
     )
-    rng = np.random.default_rng(2)
+    rng = np.random.default_rng(seed)
     loads = []
-    for k in range(30):
+    for k in range(count):
         base = problem.loads[k % len(problem.loads)]
         angle = rng.uniform(-np.pi, np.pi)
+        size = 1.0 if sizes is None else rng.uniform(*sizes)
         c, s = np.cos(angle), np.sin(angle)
         turn = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-        loads.append(Load(name=f"case-{k}", force=turn @ base.force, point=turn @ base.point,
-                          torque=base.torque))  # fmt: skip
-    checked = dataclasses.replace(problem, contacts=contacts, loads=tuple(loads), objective="check")
+        loads.append(Load(name=f"case-{k}", force=size * turn @ base.force,
+                          point=turn @ base.point, torque=size * base.torque))  # fmt: skip
+    return dataclasses.replace(problem, contacts=contacts, loads=tuple(loads), objective="check")
+
+
+def test_a_linear_check_of_many_cases_equals_each_case_solved_alone():
+    # fixture-321 (pyramids) at its planned clamp forces, 30 turned load cases: solved one by
+    # one in an order of similar loads through the simplex (from the third solve on), and
+    # returned in the cases' own order.
+    checked = turned_fixture_321(30, seed=2)
+    loads = checked.loads
     planner = Planner(checked)
     for _ in range(3):
         plan = planner.solve()

@@ -3,24 +3,32 @@
 of a case held at no multiple, against the conditions of Farkas's lemma."""
 
 import dataclasses
-from pathlib import Path
 
 import numpy as np
 import pytest
+from test_dual_simplex import turned_fixture_321
 
-from fixplan.io.problem_file import load_problem
 from fixplan.planner.planner import Planner
 from fixplan.planner.problem import Body, Contact, Load, Problem
-from fixplan.planner.runner import Runner
+from fixplan.planner.runner import Runner, _block_of
+
+
+def _block_by_block(self, objective, wrenches, given, order, numbers, sense, disabled, progress):
+    """The general path in the lane's place: one block per case, in the lane's order."""
+    return [
+        (self._run_block(objective, *_block_of(order[p : p + 1], 1, wrenches, given, None,
+                                              numbers), sense, False, disabled), 1)
+        for p in range(len(order))
+    ]  # fmt: skip
 
 
 @pytest.fixture
 def block_path(monkeypatch):
-    """Plans through the general path: the one-by-one lane declined."""
+    """Plans through the general path instead of the one-by-one lane."""
 
     def solve(problem):
         with monkeypatch.context() as patch:
-            patch.setattr(Runner, "_one_by_one", lambda self, *args: None)
+            patch.setattr(Runner, "_one_by_one", _block_by_block)
             return Planner(problem).solve()
 
     return solve
@@ -28,39 +36,17 @@ def block_path(monkeypatch):
 
 @pytest.fixture
 def lane_used(monkeypatch):
-    """The number of cases of each call the one-by-one lane answered."""
+    """The number of cases of each call of the one-by-one lane."""
     answered = []
     original = Runner._one_by_one
 
     def spy(self, *args):
-        merged = original(self, *args)
-        if merged is not None:
-            answered.append(args[1].shape[1])  # (the task wrenches)
-        return merged
+        results = original(self, *args)
+        answered.append(len(results))
+        return results
 
     monkeypatch.setattr(Runner, "_one_by_one", spy)
     return answered
-
-
-def _turned_fixture_321(count: int) -> Problem:
-    """fixture-321 (pyramids) at its planned clamp forces, ``count`` turned load cases."""
-    problem = load_problem(Path(__file__).resolve().parents[1] / "problems" / "fixture-321.toml")
-    problem = problem.problem
-    forces = Planner(problem).solve().forces
-    contacts = tuple(
-        dataclasses.replace(c, force=float(forces[c.name])) if c.name in forces else c
-        for c in problem.contacts
-    )
-    rng = np.random.default_rng(7)
-    loads = []
-    for k in range(count):
-        base = problem.loads[k % len(problem.loads)]
-        angle, size = rng.uniform(-np.pi, np.pi), rng.uniform(0.2, 3.0)
-        c, s = np.cos(angle), np.sin(angle)
-        turn = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-        loads.append(Load(name=f"case-{k}", force=size * turn @ base.force,
-                          point=turn @ base.point, torque=size * base.torque))  # fmt: skip
-    return dataclasses.replace(problem, contacts=contacts, loads=tuple(loads), objective="check")
 
 
 def _assert_same_plans(plan, reference):
@@ -82,7 +68,7 @@ def _assert_same_plans(plan, reference):
 def test_the_lane_gives_the_plan_of_one_block_per_case(block_path, lane_used):
     # The same parameter vectors and the same simplex in the same order of cases: the same
     # numbers to the last bit, for loads of sizes 0.2 to 3 (several force units).
-    problem = _turned_fixture_321(40)
+    problem = turned_fixture_321(40, seed=7, sizes=(0.2, 3.0))
     plan = Planner(problem).solve()
     assert 40 in lane_used
     assert "dual simplex (direct)" in plan.solver
@@ -183,7 +169,7 @@ def _counted_plans(monkeypatch, problem, later, *, lane):
     with monkeypatch.context() as patch:
         patch.setattr(DirectSolver, "solve", counted)
         if not lane:
-            patch.setattr(Runner, "_one_by_one", lambda self, *args: None)
+            patch.setattr(Runner, "_one_by_one", _block_by_block)
         planner = Planner(problem)
         for loads in (None, None, later):
             calls[0] = 0

@@ -201,21 +201,21 @@ class Runner:
         # One by one (linear programs), the cases go in an order of similar loads, so that
         # each starts the simplex from a nearby basis.
         order = _similar_order(wrenches) if block == 1 else np.arange(cases)
-        if block == 1 and unloaded is None and not accurate:
-            merged = self._one_by_one(objective, wrenches, given, order, numbers, sense,
-                                      disabled, progress)  # fmt: skip
-            if merged is not None:
-                return merged
-        results = []
-        for start in range(0, cases, block):
-            index = order[start : min(start + block, cases)]
-            result = self._run_block(
-                objective, *_block_of(index, block, wrenches, given, unloaded, numbers), sense,
-                accurate, disabled,
-            )  # fmt: skip
-            results.append((result, len(index)))
-            if progress is not None:
-                progress(min(start + block, cases), cases)
+        scalars = all(isinstance(value, float) for value in given.values())
+        if block == 1 and unloaded is None and not accurate and scalars:
+            results = self._one_by_one(objective, wrenches, given, order, numbers, sense,
+                                       disabled, progress)  # fmt: skip
+        else:
+            results = []
+            for start in range(0, cases, block):
+                index = order[start : min(start + block, cases)]
+                result = self._run_block(
+                    objective, *_block_of(index, block, wrenches, given, unloaded, numbers),
+                    sense, accurate, disabled,
+                )  # fmt: skip
+                results.append((result, len(index)))
+                if progress is not None:
+                    progress(min(start + block, cases), cases)
         merged = _merge(results)
         if block == 1:  # back to the cases' own order
             back = np.argsort(order)
@@ -226,28 +226,22 @@ class Runner:
 
     def _one_by_one(
         self, objective, wrenches, given, order, numbers, sense, disabled, progress
-    ) -> dict | None:
-        """The cases of a linear fixed-force objective, one by one in ``order``, each straight
-        through the direct solver with its parameter vector written here: the given forces set
-        once per force unit, only the task wrench per case. (`check` of fixture-321 × 1,000:
-        6,322-6,500 cases/s this way, 4,053-4,380 through :meth:`_run_block`.) A case the direct
-        solver does not solve, and those before it exists, take that path (a case the direct
-        solver failed on without trying it again: a second try would count as a second missed
-        warm start of the simplex). ``None`` where the given forces differ between cases (that
-        path then takes them all)."""
-        if not all(isinstance(value, float) for value in given.values()):
-            return None
+    ) -> list[tuple[dict, int]]:
+        """The results of the cases of a linear fixed-force objective whose given forces are
+        plain numbers, one by one in ``order``, each straight through the direct solver with
+        its parameter vector written here: the given forces set once per force unit, only the
+        task wrench per case. (`check` of fixture-321 × 1,000: 6,322-6,500 cases/s this way,
+        4,053-4,380 through :meth:`_run_block`.) A case the direct solver does not solve, and
+        those before it exists, take that path (a case the direct solver failed on without
+        trying it again: a second try would count as a second missed warm start of the
+        simplex)."""
         key = (objective, False)
         stacked = self.stacked(*key)
-        cases = wrenches.shape[1]
-        normal = np.zeros((len(stacked.decided), cases))
-        friction = np.zeros((stacked.friction.shape[0], cases))
-        scale, dual = np.zeros(cases), np.zeros((6, cases))
-        results, solvers, set_in = [], [], None  # set_in: the unit the parameters were set in
+        results, set_in = [], None  # set_in: the unit the parameters were set in
         for position, j in enumerate(order):
             direct = self._direct.get(key)
             unit = self._force_unit(wrenches[:, j : j + 1], given)
-            values = None
+            result = None
             if direct is not None:
                 if set_in != unit:
                     self._set_parameters(key, stacked, wrenches[:, j : j + 1] / unit, given,
@@ -255,41 +249,20 @@ class Runner:
                     vector, set_in = direct.parameter_vector(), unit
                     task = direct.entries(stacked.task)
                 vector[task] = wrenches[:, j] / unit
-                values = direct.solve(vector=vector)
-            if values is None:
+                result = self._direct_result(key, stacked, vector)
+            if result is None:
                 result = self._run_block(
                     objective, *_block_of(order[position : position + 1], 1, wrenches, given,
                                           None, numbers), sense, False, disabled,
                     direct_failed=direct is not None,
                 )  # fmt: skip
-                results.append((result, j))
-                solvers.append(result["solver"])
                 set_in = None  # (that path set the parameters)
             else:
-                answer = _values(stacked, values)
-                normal[:, j] = answer["normal"][:, 0] * unit
-                friction[:, j] = answer["friction"][:, 0] * unit
-                scale[j] = answer["scale"][0]
-                dual[:, j] = direct.dual(stacked.balance)[:, 0] / unit
-                solvers.append(f"{direct.method} (direct)")
+                result = _in_newtons(result, unit, objective)
+            results.append((result, 1))
             if progress is not None:
-                progress(position + 1, cases)
-        merged = {"status": "optimal", "solver": _joined(dict.fromkeys(solvers)),
-                  "warnings": [],
-                  "normal": normal, "friction": friction, "scale": scale, "dual": dual}  # fmt: skip
-        infeasible, missing = np.zeros(cases, dtype=bool), set()
-        for result, j in results:
-            merged["status"] = max(merged["status"], result["status"], key=_SEVERITY.index)
-            merged["warnings"] += result["warnings"]
-            infeasible[j] = result["status"] == "infeasible"
-            for name in ("normal", "friction", "scale", "dual"):
-                if result.get(name) is None:
-                    missing.add(name)
-                else:
-                    merged[name][..., j] = result[name][..., 0]
-        if merged["status"] == "infeasible":  # the certificates of the infeasible cases alone
-            dual[:, ~infeasible] = 0.0
-        return {name: value for name, value in merged.items() if name not in missing}
+                progress(position + 1, len(order))
+        return results
 
     def _run_block(
         self, objective, wrenches, given, unloaded, numbers, sense, accurate, disabled,
@@ -533,11 +506,12 @@ class Runner:
         stacked.balance.save_dual_value(dual)
         return True
 
-    def _direct_result(self, key: tuple, stacked: Stacked) -> dict | None:
-        """Solve straight through Clarabel when a direct solver exists for ``key`` (the answer
-        read from the solution, not through the cvxpy variables)."""
+    def _direct_result(self, key: tuple, stacked: Stacked, vector=None) -> dict | None:
+        """Solve straight through Clarabel when a direct solver exists for ``key`` (with the
+        parameters' values, or those of the parameter ``vector``; the answer read from the
+        solution, not through the cvxpy variables)."""
         direct = self._direct.get(key)
-        values = None if direct is None else direct.solve()
+        values = None if direct is None else direct.solve(vector=vector)
         if values is None:
             return None
         solver = f"{direct.method} (direct)"
