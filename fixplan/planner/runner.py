@@ -230,8 +230,8 @@ class Runner:
         """The results of the cases of a linear fixed-force objective whose given forces are
         plain numbers, one by one in ``order``, each straight through the direct solver with
         its parameter vector written here: the given forces set once per force unit, only the
-        task wrench per case. (`check` of fixture-321 × 1,000: 6,322-6,500 cases/s this way,
-        4,053-4,380 through :meth:`_run_block`.) A case the direct solver does not solve, and
+        task wrench per case. (`check` of fixture-321 × 1,000: 1.2-1.5× the cases per second of
+        :meth:`_run_block` per case, in alternating solves.) A case the direct solver does not solve, and
         those before it exists, take that path (a case the direct solver failed on without
         trying it again: a second try would count as a second missed warm start of the
         simplex)."""
