@@ -7,13 +7,15 @@ continuation. The iterates are those of the NumPy path to rounding; only the Pyt
 iteration is gone (a few microseconds per query on a few points instead of half a millisecond).
 
 Kernels are passed as a tuple ``(kind, x, y, weights, edges, reach, transform, posed)``: points
-``x``, ``y`` [m] with friction ``weights`` (the far-field rule of a polygon), the polygon's edge
-table ``(7, E)`` and its far-field radius ``reach`` [m] (``kind`` :data:`EDGES`) or the disk
-table ``(3, D)`` in its place (``kind`` :data:`DISKS`), and the ``transform`` (3x3) from
-contact-frame to local twists when ``posed``.
+``x``, ``y`` [m] with friction ``weights`` (the far-field rule of a polygon or grid), the
+polygon's edge table ``(7, E)`` (``kind`` :data:`EDGES`) or the grid's node table ``(3, N)``
+(``kind`` :data:`NODES`) with its far-field radius ``reach`` [m], or the disk table ``(3, D)``
+in its place (``kind`` :data:`DISKS`), and the ``transform`` (3x3) from contact-frame to local
+twists when ``posed``.
 
 The per-twist terms come from :mod:`~fixplan.surface.point_kernel`,
-:mod:`~fixplan.surface.polygon_kernel` and :mod:`~fixplan.surface.disk_compiled`. numba keys its on-disk cache by each compiled function's
+:mod:`~fixplan.surface.polygon_kernel`, :mod:`~fixplan.surface.grid_kernel` and
+:mod:`~fixplan.surface.disk_compiled`. numba keys its on-disk cache by each compiled function's
 own file, so after editing those modules in a working copy, delete the cache folder
 (:func:`~fixplan.surface.point_kernel.user_cache_dir`): the cached loops here would keep the old
 terms. (Installing a new version replaces every file, which invalidates the whole cache.)
@@ -30,6 +32,7 @@ import numpy as np
 from fixplan.errors import ConvergenceError
 from fixplan.surface.disk_compiled import _DISK_TERMS, PROFILES
 from fixplan.surface.disk_kernel import AnnulusKernel, DiskKernel
+from fixplan.surface.grid_kernel import _NODE_TERMS, GridKernel
 from fixplan.surface.kernels import PosedKernel, SupportKernel, twist_to_local
 from fixplan.surface.point_kernel import (
     _POINT_TERMS,
@@ -47,11 +50,12 @@ from fixplan.tolerances import (
     INVERSE_RTOL,
 )
 
-#: Kinds of compiled kernels: weighted points, polygon edges with a far-field point rule, or
-#: closed-form disks.
+#: Kinds of compiled kernels: weighted points, polygon edges or grid nodes with a far-field
+#: point rule, or closed-form disks.
 POINTS = 0
 EDGES = 1
 DISKS = 2
+NODES = 3
 
 #: Number of nearest support points whose facets are tested per query.
 FACETS_TESTED = 3
@@ -103,8 +107,11 @@ def _terms(kernel, eps2, twist, with_hessian, local, out):  # pragma: no cover -
     target = local if posed else out
     if kind == DISKS:
         _DISK_TERMS(edges, vx, vy, w, with_hessian, target)
-    elif kind == EDGES and abs(w) * reach > math.sqrt(vx * vx + vy * vy):
-        _EDGE_TERMS(edges, vx, vy, w, with_hessian, target)
+    elif kind != POINTS and abs(w) * reach > math.sqrt(vx * vx + vy * vy):
+        if kind == EDGES:
+            _EDGE_TERMS(edges, vx, vy, w, with_hessian, target)
+        else:
+            _NODE_TERMS(edges, vx, vy, w, with_hessian, target)
     else:
         _POINT_TERMS(px, py, pw, eps2, vx, vy, w, with_hessian, target)
     if not posed:
@@ -584,11 +591,12 @@ def compile_kernel(kernel: SupportKernel) -> CompiledKernel | None:
             return None  # facets are tested in the contact frame
         parts = (POINTS, *_point_columns(kernel), no_edges, 0.0, transform, posed)
         return CompiledKernel(parts=parts, discrete=kernel.discrete, work=len(kernel.weights))
-    if isinstance(kernel, EdgeSumKernel):
+    if isinstance(kernel, EdgeSumKernel | GridKernel):
+        kind = EDGES if isinstance(kernel, EdgeSumKernel) else NODES
+        table = np.array(kernel.table, dtype=float)
         reach = FAR_FIELD_RADII * kernel.size
-        edges = np.array(kernel.edge_table, dtype=float)
-        parts = (EDGES, *_point_columns(kernel.far), edges, reach, transform, posed)
-        return CompiledKernel(parts=parts, discrete=False, work=kernel.edge_table.shape[1])
+        parts = (kind, *_point_columns(kernel.far), table, reach, transform, posed)
+        return CompiledKernel(parts=parts, discrete=False, work=table.shape[1])
     return None
 
 

@@ -39,6 +39,7 @@ from fixplan.errors import InvalidArgumentError
 from fixplan.surface.compiled_inverse import compile_kernel
 from fixplan.surface.disk_kernel import AnnulusKernel, DiskKernel
 from fixplan.surface.geometry import Pose, triangulate
+from fixplan.surface.grid_kernel import GridKernel, grid_nodes
 from fixplan.surface.inverse import solve
 from fixplan.surface.kernels import PosedKernel, SumKernel, SupportKernel
 from fixplan.surface.point_kernel import PointSetKernel
@@ -51,7 +52,7 @@ from fixplan.surface.pressure import (
     PolygonField,
     PressureField,
 )
-from fixplan.surface.rules import gauss_jacobi_unit, triangle_rule
+from fixplan.surface.rules import triangle_rule
 from fixplan.surface.sphere import circle, fibonacci_sphere
 from fixplan.tolerances import CONTAINMENT_RTOL
 
@@ -446,48 +447,18 @@ def _cell_squares(field: GridField) -> tuple[np.ndarray, np.ndarray]:
     return centers[:, None, :] + corners[None, :, :], fractions
 
 
-def _grid_edges(field: GridField, fractions: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Directed edges (starts, ends ``(E, 2)`` [m]) and weights ``(E,)`` [1/m²] of the loaded
-    cells' boundaries, each edge of the lattice of cell corners once.
-
-    Every cell's counter-clockwise boundary with its pressure ``p`` (``fractions`` of the loaded
-    cells over the cell area) gives an edge between two cells twice, once each way. The edge
-    terms are linear in the weight and change sign with the direction, so the pair is one edge
-    with weight ``p_left - p_right``, and none between equal pressures. The merged table is the
-    same combination of the closed cell boundaries, so the antisymmetric Hessian part that
-    :mod:`~fixplan.surface.polygon_kernel` leaves out (also linear and odd) still sums to zero.
-    Edges along x join corners ``(i, k)`` and ``(i + 1, k)``, edges along y ``(i, k)`` and
-    ``(i, k + 1)`` (corner ``i`` along x, ``k`` along y).
-    """
-    dx, dy = field.cell_size
-    ny, nx = field.values.shape
-    pressure = np.zeros((ny + 2, nx + 2))  # a ring of empty cells around the grid
-    pressure[1:-1, 1:-1][field.values > 0.0] = fractions / (dx * dy)
-    along_x = np.diff(pressure[:, 1:-1], axis=0)  # (ny + 1, nx): the cell above minus below
-    along_y = -np.diff(pressure[1:-1, :], axis=1)  # (ny, nx + 1): the cell left minus right
-    corner_x = field.x[0] + (np.arange(nx + 1) - 0.5) * dx
-    corner_y = field.y[0] + (np.arange(ny + 1) - 0.5) * dy
-    kx, ix = np.nonzero(along_x)
-    ky, iy = np.nonzero(along_y)
-    x_start = np.concatenate([corner_x[ix], corner_x[iy]])
-    y_start = np.concatenate([corner_y[kx], corner_y[ky]])
-    x_end = np.concatenate([corner_x[ix + 1], corner_x[iy]])
-    y_end = np.concatenate([corner_y[kx], corner_y[ky + 1]])
-    weights = np.concatenate([along_x[kx, ix], along_y[ky, iy]])
-    return np.column_stack([x_start, y_start]), np.column_stack([x_end, y_end]), weights
-
-
-def _grid_kernel(field: GridField) -> EdgeSumKernel:
+def _grid_kernel(field: GridField) -> GridKernel:
+    """The node kernel of a grid, with the cells' Gauss rule for far centres of rotation."""
     centers, fractions = field.cells()
     dx, dy = field.cell_size
-    starts, ends, weights = _grid_edges(field, fractions)
+    ny, nx = field.values.shape
+    pressure = np.zeros((ny, nx))
+    pressure[field.values > 0.0] = fractions / (dx * dy)
+    corner_x = field.x[0] + (np.arange(nx + 1) - 0.5) * dx
+    corner_y = field.y[0] + (np.arange(ny + 1) - 0.5) * dy
     order = 8 if len(centers) <= 16 else 4 if len(centers) <= 256 else 3
-    t, wt = gauss_jacobi_unit(order)
-    ox, oy = np.meshgrid((t - 0.5) * dx, (t - 0.5) * dy, indexing="ij")
-    offsets = np.column_stack([ox.ravel(), oy.ravel()])
-    far_points = (centers[:, None, :] + offsets[None, :, :]).reshape(-1, 2)
-    far_weights = (fractions[:, None] * np.outer(wt, wt).ravel()[None, :]).ravel()
-    return EdgeSumKernel(starts, ends, weights, PointSetKernel(far_points, far_weights))
+    far = PointSetKernel(*field._local_quadrature(order))
+    return GridKernel(*grid_nodes(corner_x, corner_y, pressure), far)
 
 
 def _regions(shape: DiskField | PolygonField) -> tuple:

@@ -138,40 +138,23 @@ def _edge_sums(  # pragma: no cover - compiled
 _EDGE_SUMS = _compiled(_edge_sums)
 
 
-@dataclass(frozen=True, slots=True)
-class EdgeSumKernel(SupportKernel):
-    """Unit-friction support function of piecewise-uniform pressure given by weighted edges.
+class ClosedFormKernel(SupportKernel):
+    """A kernel summed in closed form over a table (``_table``, read by the compiled pair
+    ``_NEAR_SUMS`` as :func:`_edge_sums` reads edges) for centres of rotation within
+    :data:`~fixplan.tolerances.FAR_FIELD_RADII` sizes, and by the Gauss rule ``far`` of the same
+    field beyond (and for pure translations), where the closed-form terms cancel. Subclasses set
+    ``_table`` and ``_size`` (the far rule's, computed once) on construction."""
 
-    ``starts``/``ends`` ``(E, 2)`` [m] are directed boundary edges (region on their left),
-    ``weights`` ``(E,)`` the pressure [1/m²] of the region they bound (normalised to unit total
-    force), and ``far`` a Gauss rule of the same field for far centres of rotation.
-    """
-
-    starts: np.ndarray
-    ends: np.ndarray
-    weights: np.ndarray
-    far: PointSetKernel
-    _edges: np.ndarray = field(init=False, repr=False)
-    _size: float = field(init=False, repr=False)
-
-    def __post_init__(self):
-        starts = np.asarray(self.starts, dtype=float)
-        ends = np.asarray(self.ends, dtype=float)
-        direction = ends - starts
-        length = np.hypot(direction[:, 0], direction[:, 1])
-        columns = (starts, ends, direction / length[:, None], np.asarray(self.weights, dtype=float))
-        edges = np.ascontiguousarray(np.column_stack(columns).T)
-        object.__setattr__(self, "_edges", edges)
-        object.__setattr__(self, "_size", self.far.size)
+    __slots__ = ()
 
     @property
     def size(self) -> float:
         return self._size
 
     @property
-    def edge_table(self) -> np.ndarray:
-        """The edges ``(7, E)`` as :func:`edge_terms` reads them (do not modify)."""
-        return self._edges
+    def table(self) -> np.ndarray:
+        """The table the compiled sums read (do not modify)."""
+        return self._table
 
     def _sums(self, twists, with_hessian):
         twists = np.ascontiguousarray(twists, dtype=float)
@@ -180,8 +163,8 @@ class EdgeSumKernel(SupportKernel):
         g = np.empty((count, 3))
         hess = np.empty((count if with_hessian else 0, 3, 3))
         far = np.empty(count, dtype=np.bool_)
-        far_count = _pick(_EDGE_SUMS, count, len(self.weights))(
-            self._edges, FAR_FIELD_RADII * self._size, twists, with_hessian, h, g, hess, far
+        far_count = _pick(self._NEAR_SUMS, count, self._table.shape[1])(
+            self._table, FAR_FIELD_RADII * self.size, twists, with_hessian, h, g, hess, far
         )
         return twists, far if far_count else None, h, g, hess
 
@@ -199,6 +182,35 @@ class EdgeSumKernel(SupportKernel):
 
     def hessian(self, twists):
         return self.newton_terms(twists)[2]
+
+
+@dataclass(frozen=True, slots=True)
+class EdgeSumKernel(ClosedFormKernel):
+    """Unit-friction support function of piecewise-uniform pressure given by weighted edges.
+
+    ``starts``/``ends`` ``(E, 2)`` [m] are directed boundary edges (region on their left),
+    ``weights`` ``(E,)`` the pressure [1/m²] of the region they bound (normalised to unit total
+    force), and ``far`` a Gauss rule of the same field for far centres of rotation. Its
+    :attr:`table` ``(7, E)`` holds the starts' x and y, the ends' x and y, the unit directions'
+    x and y and the weights (:func:`edge_terms`).
+    """
+
+    starts: np.ndarray
+    ends: np.ndarray
+    weights: np.ndarray
+    far: PointSetKernel
+    _table: np.ndarray = field(init=False, repr=False)
+    _size: float = field(init=False, repr=False)
+    _NEAR_SUMS = _EDGE_SUMS
+
+    def __post_init__(self):
+        starts = np.asarray(self.starts, dtype=float)
+        ends = np.asarray(self.ends, dtype=float)
+        direction = ends - starts
+        length = np.hypot(direction[:, 0], direction[:, 1])
+        columns = (starts, ends, direction / length[:, None], np.asarray(self.weights, dtype=float))
+        object.__setattr__(self, "_table", np.ascontiguousarray(np.column_stack(columns).T))
+        object.__setattr__(self, "_size", self.far.size)
 
 
 def polygon_edges(vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

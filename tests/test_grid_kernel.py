@@ -1,11 +1,12 @@
-"""The tactile-grid kernel holds each edge of the lattice of cell corners once, weighted by the
-pressure on its left minus that on its right, and equals the kernel of every loaded cell's own
-four edges (how the grid kernel was built before edges were merged).
+"""The tactile-grid kernel holds each corner of the cell lattice once, weighted by the mixed
+second difference of the pressures of the four cells around it, and equals the kernel of every
+loaded cell's own four edges.
 
-Reference: :func:`four_edges_per_cell` builds that unmerged kernel here, from the field's cell
-centres and values; merging changes only the order and grouping of a sum of the same terms, so
-values, loads and Hessians agree to rounding (:data:`KERNEL_RTOL`). The far-field Gauss rule is
-not merged: the reference uses the same rule.
+Reference: :func:`four_edges_per_cell` builds that kernel here, from the field's cell centres
+and values, with the edge sums of :mod:`~fixplan.surface.polygon_kernel` (a different closed
+form: signed triangles over each edge, where the grid kernel sums an antiderivative over the
+corners). Values, loads and Hessians agree to rounding (:data:`KERNEL_RTOL`). The far-field Gauss
+rule is the same in both.
 """
 
 from __future__ import annotations
@@ -15,15 +16,19 @@ import pytest
 
 from fixplan import LimitSurface, pressure
 from fixplan.surface import limit_surface
+from fixplan.surface.grid_kernel import GridKernel
 from fixplan.surface.kernels import PosedKernel
 from fixplan.surface.point_kernel import PointSetKernel
 from fixplan.surface.polygon_kernel import EdgeSumKernel
 from fixplan.tolerances import FAR_FIELD_RADII, INVERSE_RTOL
 
-#: Merged against unmerged kernel, per twist: support value relative to itself, load and Hessian
-#: (moments divided by the patch size) relative to their largest component. Rounding of sums of
-#: up to a few thousand terms is ~1e-14.
-KERNEL_RTOL = 1e-12
+#: Node against edge kernel, per twist: support value relative to itself, load and Hessian
+#: (moments divided by the patch size) relative to their largest component. Both sum terms of
+#: size ``R³`` (distance ``R`` to the centre of rotation) to a total of size ``R`` times the
+#: patch area, so rounding grows with ``R`` over the cell size: on the 120 x 150 grid, with the
+#: centre at 3.1 sizes, the edge sums' Hessian is 1.8e-12 off the node formula evaluated in
+#: 80-bit long double, the node sums' 2.0e-13.
+KERNEL_RTOL = 5e-12
 #: Safety factors through the inverse map: Newton stops when the twist is within about
 #: INVERSE_RTOL, which leaves the safety factor within its square; rounding dominates.
 SAFETY_RTOL = 1e-12
@@ -70,6 +75,7 @@ GRIDS = {
     "one row of 7 cells": lambda: make_grid(lone(3, 7, slice(1, 2), slice(0, 7), 3)),
     "one column of 5 cells": lambda: make_grid(lone(5, 2, slice(0, 5), slice(1, 2), 4)),
     "Hertz map of 30 x 40 cells": lambda: make_grid(hertz_values(30, 40)),
+    "Hertz map of 120 x 150 cells": lambda: make_grid(hertz_values(120, 150)),
     "posed random grid": lambda: (
         make_grid(random_values(6, 8, 5)).rotated(0.7, about=(0.003, -0.002)).shifted(0.01, -0.02)
     ),
@@ -98,45 +104,41 @@ def four_edges_per_cell(field: pressure.GridField) -> EdgeSumKernel:
     return EdgeSumKernel(starts, ends, weights, far_rule(field))
 
 
-def merged_and_unmerged_kernels(field, monkeypatch):
+def node_and_edge_kernels(field, monkeypatch) -> tuple[GridKernel, EdgeSumKernel]:
     """The library's kernel of ``field`` and the same with :func:`four_edges_per_cell`."""
-    merged = limit_surface._field_kernel(field)
+    nodes = limit_surface._field_kernel(field)
     with monkeypatch.context() as patch:
         patch.setattr(limit_surface, "_grid_kernel", four_edges_per_cell)
-        unmerged = limit_surface._field_kernel(field)
-    return merged, unmerged
+        edges = limit_surface._field_kernel(field)
+    return nodes, edges
 
 
-def lattice_edges(field: pressure.GridField) -> dict:
-    """Merged weights [1/m²] by lattice edge, summed cell by cell in plain Python: keys
-    ``((i, k), (i', k'))`` with the corners in increasing order, weights for that direction."""
+def lattice_nodes(field: pressure.GridField) -> dict:
+    """Mixed differences [1/m²] by lattice corner ``(i, k)`` (``i`` along x, ``k`` along y),
+    summed cell by cell in plain Python: a cell's pressure counts positive at its lower-left and
+    upper-right corners and negative at the other two."""
     dx, dy = field.cell_size
     _, fractions = field.cells()
     rows, columns = np.nonzero(field.values > 0.0)
-    edges = {}
+    nodes = {}
     for k, i, fraction in zip(rows.tolist(), columns.tolist(), fractions.tolist(), strict=True):
         p = fraction / (dx * dy)
-        corners = [(i, k), (i + 1, k), (i + 1, k + 1), (i, k + 1)]
-        for a, b in zip(corners, corners[1:] + corners[:1], strict=True):
-            key, sign = ((a, b), 1.0) if a < b else ((b, a), -1.0)
-            edges[key] = edges.get(key, 0.0) + sign * p
-    return {key: weight for key, weight in edges.items() if weight != 0.0}
+        for corner, sign in (((i, k), 1), ((i + 1, k), -1), ((i + 1, k + 1), 1), ((i, k + 1), -1)):
+            nodes[corner] = nodes.get(corner, 0.0) + sign * p
+    return {corner: kappa for corner, kappa in nodes.items() if abs(kappa) > 1e-12 * abs(p)}
 
 
-def table_edges(kernel: EdgeSumKernel, field: pressure.GridField) -> dict:
-    """The kernel's edge table as in :func:`lattice_edges` (corners rounded to the lattice)."""
+def table_nodes(kernel: GridKernel, field: pressure.GridField) -> dict:
+    """The kernel's node table as in :func:`lattice_nodes` (corners rounded to the lattice)."""
     dx, dy = field.cell_size
-    table = kernel.edge_table
+    x, y, kappa = kernel.table
     origin = np.array([field.x[0] - dx / 2, field.y[0] - dy / 2])
-    starts = np.rint((table[0:2].T - origin) / (dx, dy)).astype(int)
-    ends = np.rint((table[2:4].T - origin) / (dx, dy)).astype(int)
-    edges = {}
-    for a, b, weight in zip(map(tuple, starts), map(tuple, ends), table[6], strict=True):
-        key, sign = ((a, b), 1.0) if a < b else ((b, a), -1.0)
-        assert key not in edges, f"edge {key} appears twice"
-        assert np.sum(np.abs(np.subtract(b, a))) == 1, f"edge {key} is not one cell side"
-        edges[key] = sign * weight
-    return edges
+    corners = np.rint((np.column_stack([x, y]) - origin) / (dx, dy)).astype(int)
+    nodes = {}
+    for corner, value in zip(map(tuple, corners), kappa, strict=True):
+        assert corner not in nodes, f"node {corner} appears twice"
+        nodes[corner] = value
+    return nodes
 
 
 def twists(field, seed: int) -> np.ndarray:
@@ -162,38 +164,42 @@ def twists(field, seed: int) -> np.ndarray:
 
 
 @pytest.mark.parametrize("name", GRIDS)
-def test_each_lattice_edge_is_kept_once_with_the_left_minus_right_pressure(name, monkeypatch):
+def test_each_lattice_corner_is_kept_once_with_the_mixed_difference_of_its_cells(name):
     field = GRIDS[name]()
-    merged, _ = merged_and_unmerged_kernels(field, monkeypatch)
-    local = merged.local if isinstance(merged, PosedKernel) else merged
-    assert table_edges(local, field) == lattice_edges(field)
+    kernel = limit_surface._field_kernel(field)
+    local = kernel.local if isinstance(kernel, PosedKernel) else kernel
+    expected = lattice_nodes(field)
+    found = table_nodes(local, field)
+    for corner, kappa in expected.items():
+        assert found[corner] == pytest.approx(kappa, rel=1e-12), corner
+    # Differences of equal pressures summed in another order can leave rounding, no more.
+    largest = max(abs(kappa) for kappa in expected.values())
+    for corner in found.keys() - expected.keys():
+        assert abs(found[corner]) < 1e-13 * largest, corner
 
 
 @pytest.mark.parametrize(
     ("name", "count"),
-    [
-        ("uniform plateau", 2 * (5 + 6)),
-        ("one loaded cell", 4),
-        ("one row of 7 cells", 2 * 7 + 8),
-        ("one column of 5 cells", 2 * 5 + 6),
-    ],
+    [("uniform plateau", 4), ("one loaded cell", 4), ("one row of 7 cells", 2 * 8)],
 )
-def test_grids_keep_only_the_edges_between_unequal_pressures(name, count, monkeypatch):
-    field = GRIDS[name]()
-    merged, _ = merged_and_unmerged_kernels(field, monkeypatch)
-    assert merged.edge_table.shape[1] == count
+def test_grids_keep_only_the_corners_where_the_pressure_is_not_bilinear_free(name, count):
+    kernel = limit_surface._field_kernel(GRIDS[name]())
+    assert kernel.table.shape[1] == count
 
 
-def test_a_uniform_plateau_keeps_its_outer_boundary_at_the_cell_pressure(monkeypatch):
+def test_a_uniform_plateau_keeps_its_four_outer_corners_at_the_cell_pressure():
     field = GRIDS["uniform plateau"]()
-    merged, _ = merged_and_unmerged_kernels(field, monkeypatch)
-    table = merged.edge_table
+    x, y, kappa = limit_surface._field_kernel(field).table
     dx, dy = field.cell_size
-    np.testing.assert_allclose(np.abs(table[6]), 1.0 / (30 * dx * dy), rtol=1e-15)
-    x, y = table[[0, 2]], table[[1, 3]]
-    on_boundary = np.isclose(x, field.x[0] - dx / 2) | np.isclose(x, field.x[-1] + dx / 2)
-    on_boundary |= np.isclose(y, field.y[0] - dy / 2) | np.isclose(y, field.y[-1] + dy / 2)
-    assert np.all(on_boundary)
+    np.testing.assert_allclose(np.abs(kappa), 1.0 / (30 * dx * dy), rtol=1e-15)
+    assert set(np.round(x / dx, 6)) == {
+        round(field.x[0] / dx - 0.5, 6),
+        round(field.x[-1] / dx + 0.5, 6),
+    }
+    assert set(np.round(y / dy, 6)) == {
+        round(field.y[0] / dy - 0.5, 6),
+        round(field.y[-1] / dy + 0.5, 6),
+    }
 
 
 def errors(size, terms, reference):
@@ -213,16 +219,16 @@ def errors(size, terms, reference):
 
 
 @pytest.mark.parametrize("name", GRIDS)
-def test_merged_kernel_equals_the_four_edges_per_cell_kernel(name, monkeypatch):
+def test_node_kernel_equals_the_four_edges_per_cell_kernel(name, monkeypatch):
     field = GRIDS[name]()
-    merged, unmerged = merged_and_unmerged_kernels(field, monkeypatch)
+    nodes, edges = node_and_edge_kernels(field, monkeypatch)
     batch = twists(field, seed=len(name))
-    near = FAR_FIELD_RADII * merged.size * np.abs(batch[:, 2]) > np.hypot(batch[:, 0], batch[:, 1])
+    near = FAR_FIELD_RADII * nodes.size * np.abs(batch[:, 2]) > np.hypot(batch[:, 0], batch[:, 1])
     assert np.count_nonzero(near) >= 40 and np.count_nonzero(~near) >= 10
     for method in ("evaluate", "newton_terms"):
-        terms, reference = getattr(merged, method)(batch), getattr(unmerged, method)(batch)
+        terms, reference = getattr(nodes, method)(batch), getattr(edges, method)(batch)
         names = ["value", "load", "Hessian"][: len(terms)]
-        for what, error in zip(names, errors(merged.size, terms, reference), strict=True):
+        for what, error in zip(names, errors(nodes.size, terms, reference), strict=True):
             assert np.max(error) < KERNEL_RTOL, f"{method}: {what} off by {np.max(error):.1e}"
 
 

@@ -1,0 +1,162 @@
+r"""Closed-form support function of a tactile grid (piecewise-uniform cells), node by node.
+
+Over a cell ``[x₀, x₁] × [y₀, y₁]`` of uniform pressure ``p`` the moment function
+``M(c) = ∫ p |x - c| dA`` is ``p [G(X₁, Y₁) - G(X₀, Y₁) - G(X₁, Y₀) + G(X₀, Y₀)]`` with
+``X = x - c_x``, ``Y = y - c_y`` and ``G`` the antiderivative with ``∂²G/∂X∂Y = R``
+(``R = sqrt(X² + Y²)``, ``A = asinh(Y/|X|)``, ``B = asinh(X/|Y|)``):
+
+.. math::
+
+   G = \tfrac13 X Y R + \tfrac16 X^3 A + \tfrac16 Y^3 B,\qquad
+   G_X = \tfrac12 (Y R + X^2 A),\quad G_Y = \tfrac12 (X R + Y^2 B),
+
+   G_{XX} = X A,\qquad G_{XY} = R,\qquad G_{YY} = Y B.
+
+Cells share corners, so the whole grid is one sum over the corners (nodes) of the lattice, each
+with the mixed second difference ``κ`` of the cell pressures around it (the cells up-right and
+down-left minus the other two; zero inside a region of uniform or bilinear-free pressure):
+``M = Σ κ G``, ``∇M = -Σ κ (G_X, G_Y)``, ``∇²M = Σ κ [[G_XX, G_XY], [G_XY, G_YY]]``. Each node
+costs one square root and two logarithms; the edge sums of
+:mod:`~fixplan.surface.polygon_kernel` cost two square roots and two ``asinh`` per lattice edge,
+and a grid has about twice as many edges as nodes. The support function and its Hessian follow
+from ``M`` as there, and far centres of rotation (where the terms, of size ``R³``, cancel) go to
+the Gauss rule of the cells as there.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numba
+import numpy as np
+
+from fixplan.surface.point_kernel import (
+    _UNPACK_HESSIAN,
+    PointSetKernel,
+    _compiled,
+    compiled_scalar,
+)
+from fixplan.surface.polygon_kernel import ClosedFormKernel
+
+#: Below this fraction of ``R``, ``|X|`` (or ``|Y|``) is taken as zero in ``asinh(Y/|X|)``: the
+#: terms carrying it (``X A``, ``X² A``, ``X³ A``) are then below ``1e-28 R`` and the quotient
+#: cannot overflow.
+_ON_AXIS = 1e-30
+
+
+def node_terms(nodes, vx, vy, w, with_hessian, out):  # pragma: no cover - compiled
+    """Support value, load and (``with_hessian``) Hessian at one twist ``(vx, vy, w)`` with
+    ``w != 0``, written to ``out`` ``(10,)`` as :func:`~fixplan.surface.point_kernel.point_terms`
+    does. ``nodes`` ``(3, N)`` holds the nodes' x, y [m] and mixed differences ``κ`` [1/m²]."""
+    cx = -vy / w
+    cy = vx / w
+    moment = 0.0
+    gx = 0.0  # ∇M
+    gy = 0.0
+    m00 = 0.0  # ∇²M
+    m01 = 0.0
+    m11 = 0.0
+    for i in range(nodes.shape[1]):
+        k = nodes[2, i]
+        x = nodes[0, i] - cx
+        y = nodes[1, i] - cy
+        ax = abs(x)
+        ay = abs(y)
+        r = math.sqrt(x * x + y * y)
+        xa = 0.0  # X asinh(Y/|X|)
+        if ax > _ON_AXIS * r:
+            xa = x * math.log((ay + r) / ax)
+            if y < 0.0:
+                xa = -xa
+        yb = 0.0  # Y asinh(X/|Y|)
+        if ay > _ON_AXIS * r:
+            yb = y * math.log((ax + r) / ay)
+            if x < 0.0:
+                yb = -yb
+        moment += k * (x * y * r * (1.0 / 3.0) + (x * x * xa + y * y * yb) * (1.0 / 6.0))
+        gx -= k * 0.5 * (y * r + x * xa)
+        gy -= k * 0.5 * (x * r + y * yb)
+        if with_hessian:
+            m00 += k * xa
+            m01 += k * r
+            m11 += k * yb
+    sign = 1.0 if w > 0.0 else -1.0
+    out[0] = abs(w) * moment
+    out[1] = sign * gy
+    out[2] = -sign * gx
+    out[3] = sign * (moment - cx * gx - cy * gy)
+    if with_hessian:
+        s = 1.0 / abs(w)
+        out[4] = s * m11
+        out[5] = -s * m01
+        out[6] = -s * (m01 * cx + m11 * cy)
+        out[7] = s * m00
+        out[8] = s * (m00 * cx + m01 * cy)
+        out[9] = s * (m00 * cx * cx + 2.0 * m01 * cx * cy + m11 * cy * cy)
+
+
+_NODE_TERMS = compiled_scalar(node_terms)
+
+
+def _node_sums(  # pragma: no cover - compiled
+    nodes, reach, twists, with_hessian, out_h, out_g, out_hess, out_far
+):
+    """Support values ``out_h``, loads ``out_g`` and, ``with_hessian``, Hessians ``out_hess`` of
+    the twists whose centre of rotation lies within ``reach`` [m] (:func:`node_terms`);
+    ``out_far`` marks the others (their rows are left unset), whose number is returned."""
+    far_count = 0
+    for k in numba.prange(twists.shape[0]):
+        vx, vy, w = twists[k, 0], twists[k, 1], twists[k, 2]
+        far = abs(w) * reach <= math.sqrt(vx * vx + vy * vy)
+        out_far[k] = far
+        if far:
+            far_count += 1
+            continue
+        out = np.empty(10)
+        _NODE_TERMS(nodes, vx, vy, w, with_hessian, out)
+        out_h[k] = out[0]
+        out_g[k, 0] = out[1]
+        out_g[k, 1] = out[2]
+        out_g[k, 2] = out[3]
+        if with_hessian:
+            _UNPACK_HESSIAN(out, out_hess[k])
+    return far_count
+
+
+_NODE_SUMS = _compiled(_node_sums)
+
+
+def grid_nodes(
+    corner_x: np.ndarray, corner_y: np.ndarray, pressure: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes ``(N, 2)`` [m] and their mixed differences ``κ`` ``(N,)`` [1/m²] of cells with
+    ``pressure`` ``(ny, nx)`` [1/m²] between the corners ``corner_x`` ``(nx + 1,)`` and
+    ``corner_y`` ``(ny + 1,)``; nodes with ``κ = 0`` are left out."""
+    padded = np.pad(pressure, 1)  # a ring of empty cells around the grid
+    kappa = padded[1:, 1:] + padded[:-1, :-1] - padded[1:, :-1] - padded[:-1, 1:]
+    rows, columns = np.nonzero(kappa)
+    return np.column_stack([corner_x[columns], corner_y[rows]]), kappa[rows, columns]
+
+
+@dataclass(frozen=True, slots=True)
+class GridKernel(ClosedFormKernel):
+    """Unit-friction support function of a grid of uniform cells given by its nodes.
+
+    ``nodes`` ``(N, 2)`` [m] are corners of the cell lattice with mixed pressure differences
+    ``kappa`` ``(N,)`` [1/m²] (:func:`grid_nodes`; pressures normalised to unit total force),
+    and ``far`` a Gauss rule of the cells for far centres of rotation. Its :attr:`table`
+    ``(3, N)`` holds the nodes' x, y and ``κ`` (:func:`node_terms`).
+    """
+
+    nodes: np.ndarray
+    kappa: np.ndarray
+    far: PointSetKernel
+    _table: np.ndarray = field(init=False, repr=False)
+    _size: float = field(init=False, repr=False)
+    _NEAR_SUMS = _NODE_SUMS
+
+    def __post_init__(self):
+        columns = (np.asarray(self.nodes, dtype=float), np.asarray(self.kappa, dtype=float))
+        object.__setattr__(self, "_table", np.ascontiguousarray(np.column_stack(columns).T))
+        object.__setattr__(self, "_size", self.far.size)
