@@ -108,11 +108,39 @@ def test_the_compiled_path_gives_the_answers_of_the_numpy_path(name, how):
         else:
             motions, safety = surface.motion_and_safety_factor(loads)
         np.testing.assert_allclose(safety, expected_safety, rtol=SAFETY_RTOL, err_msg=distribution)
-        a = motions * [1.0, 1.0, rho]
-        b = expected_twists * [1.0, 1.0, rho]
-        b /= np.linalg.norm(b, axis=1, keepdims=True)
-        angle = np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.einsum("ij,ij->i", a, b))
-        assert np.max(angle) <= MOTION_RAD, distribution
+        assert np.max(angles(surface, motions, expected_twists)) <= MOTION_RAD, distribution
+
+
+def angles(surface, twists, reference):
+    """Angles [rad] between twists and reference twists, moments scaled by the surface's size."""
+    rho = surface.characteristic_length
+    a = twists * [1.0, 1.0, rho]
+    b = reference * [1.0, 1.0, rho]
+    return np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.einsum("ij,ij->i", a, b))
+
+
+@pytest.mark.parametrize("name", sorted(SURFACES))
+def test_a_start_twist_moves_where_newton_starts_not_the_answer(name):
+    # The planner's exact models start the inverse map from the ellipsoid normal of the last
+    # solve; good, poor and useless starts (no positive work on the load) all give the answer.
+    surface = SURFACES[name]()
+    rng = np.random.default_rng(6)
+    loads = np.concatenate(list(distributions(surface, rng).values()))
+    expected_safety, expected_twists = numpy_path(surface, loads)
+    units = np.array([surface.max_force, surface.max_force, surface.max_moment])
+    rho = surface.characteristic_length
+    noise = rng.normal(size=loads.shape) * [1.0, 1.0, 1.0 / rho]
+    sizes = np.linalg.norm(expected_twists * [1.0, 1.0, rho], axis=1, keepdims=True)
+    starts = {
+        "the answers, scaled": expected_twists * rng.uniform(1e-3, 1e3, (len(loads), 1)),
+        "the answers, 10 % off": expected_twists + 0.1 * sizes * noise,
+        "the answers, reversed": -expected_twists,
+        "zero": np.zeros_like(loads),
+    }
+    for what, start in starts.items():
+        safety, twists = surface._compiled.solve(loads, units, surface._scale, start)
+        np.testing.assert_allclose(safety, expected_safety, rtol=SAFETY_RTOL, err_msg=what)
+        assert np.max(angles(surface, twists, expected_twists)) <= MOTION_RAD, what
 
 
 @pytest.mark.parametrize("name", sorted(SURFACES))

@@ -161,6 +161,30 @@ def test_points_default_to_equal_weights_and_are_centred():
     assert np.allclose(field.xy, [[-1.0, -1.0], [2.0, -1.0], [-1.0, 2.0]])
 
 
+def test_grid_centre_of_pressure_is_the_value_weighted_mean_of_its_cell_centres():
+    # Worked by hand from GRID_VALUES: value-weighted means of the cell centres (total 16.5),
+    # then the pose (a rotation by 0.4 rad about (0.001, 0.002) and a shift).
+    field = pressure.grid(GRID_X, GRID_Y, GRID_VALUES, centered=False)
+    values = np.asarray(GRID_VALUES)
+    local = np.array([values.sum(axis=0) @ GRID_X, values.sum(axis=1) @ GRID_Y]) / values.sum()
+    assert field.center_of_pressure() == pytest.approx(local, rel=1e-14, abs=1e-18)
+    posed = field.rotated(0.4, about=(0.001, 0.002)).shifted(0.01, -0.003)
+    c, s = math.cos(0.4), math.sin(0.4)
+    turned = np.array([[c, -s], [s, c]]) @ (local - [0.001, 0.002]) + [0.011, -0.001]
+    assert posed.center_of_pressure() == pytest.approx(turned, rel=1e-14, abs=1e-18)
+    assert posed.center_of_pressure(mu=0.4) == pytest.approx(turned, rel=1e-14, abs=1e-18)
+    # A position-dependent mu weighs the cells by mu p, by quadrature: here mu = 1 + 20 x, linear
+    # over each cell, so its mean over a cell is its value at the centre, and <x mu p> needs the
+    # cell's second moment dx²/12 as well.
+    dx = GRID_X[1] - GRID_X[0]
+    xx, yy = np.meshgrid(GRID_X, GRID_Y)
+    weight = values * (1 + 20 * xx)
+    x_mean = (np.sum(values * (xx * (1 + 20 * xx) + 20 * dx**2 / 12))) / weight.sum()
+    y_mean = np.sum(weight * yy) / weight.sum()
+    found = field.center_of_pressure(mu=lambda x, y: 1 + 20 * x)
+    assert found == pytest.approx([x_mean, y_mean], rel=1e-13)
+
+
 def test_grid_quadrature_weights_follow_the_cell_values():
     field = pressure.grid(GRID_X, GRID_Y, GRID_VALUES, centered=False)
     points, weights = field.quadrature()

@@ -109,7 +109,9 @@ class Exact(FrictionModel):
         vertices = hull.equations[:, :3] / -hull.equations[:, 3:]
         return float(np.max(self.friction_shape._gauge(vertices)) - 1.0)
 
-    def cut(self, loads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def cut(
+        self, loads: np.ndarray, start: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         r"""The tangent plane of the exact set at the ray of each load, and the loads' excess.
 
         Parameters
@@ -117,6 +119,9 @@ class Exact(FrictionModel):
         loads : numpy.ndarray
             ``(K, 3)`` loads ``(fx, fy, m)`` per unit normal force [-, -, m], nonzero and
             finite (not checked: the planner's loads, many times per solve).
+        start : numpy.ndarray, optional
+            ``(K, 3)`` guesses of the loads' sliding twists (any size) for the inverse map to
+            start from.
 
         Returns
         -------
@@ -135,11 +140,13 @@ class Exact(FrictionModel):
         support is read from the inverse map's answer instead of being integrated again
         (relative difference about 1e-14, far below the planner's ``CUT_MARGIN``).
         """
-        safety, twists = self.surface._trusted_inverse(loads * self.surface.normal_force)
+        safety, twists = self.surface._trusted_inverse(loads * self.surface.normal_force, start)
         support = safety * np.einsum("ij,ij->i", loads, twists)
         return twists / support[:, None], 1.0 / safety - 1.0
 
-    def osculating(self, loads: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def osculating(
+        self, loads: np.ndarray, start: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         r"""The ellipsoid that osculates the exact set where the ray of each load meets it.
 
         Parameters
@@ -147,6 +154,8 @@ class Exact(FrictionModel):
         loads : numpy.ndarray
             ``(K, 3)`` loads ``(fx, fy, m)`` per unit normal force [-, -, m], nonzero and
             finite (not checked).
+        start : numpy.ndarray, optional
+            ``(K, 3)`` guesses of the loads' sliding twists, as for :meth:`cut`.
 
         Returns
         -------
@@ -168,7 +177,7 @@ class Exact(FrictionModel):
         the same value, gradient and Hessian at ``u``. The algebra runs in normalised
         coordinates (loads over :meth:`_units`), where ``J`` is well conditioned.
         """
-        planes, excess = self.cut(loads)
+        planes, excess = self.cut(loads, start)
         units = self._units()
         points = loads / (1.0 + excess)[:, None]
         a, u = planes * units, points / units  # normalised plane and point, a · u = 1

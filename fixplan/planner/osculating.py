@@ -177,17 +177,19 @@ class OsculatingPool(ExactContacts):
         if not moving.any():
             self._assign()
             return settled
+        owner, cases = np.nonzero(moving)  # contact by contact
+        per_unit = per_unit[:, owner, cases].T
+        # The normals of the ellipsoids the solve used, at its loads: the exact sliding twists
+        # near the optimum (stationarity), where the inverse map starts.
+        used = _normals(self._factors[owner, cases], per_unit)
         found = [
-            model.osculating(per_unit[:, e, moving[e]].T)
+            model.osculating(per_unit[owner == e], used[owner == e])
             for e, model in enumerate(self._models)
             if moving[e].any()
         ]
-        owner, cases = np.nonzero(moving)  # contact by contact, as found
         excess, points, factors = (np.concatenate(part) for part in zip(*found, strict=True))
-        per_unit = per_unit[:, owner, cases].T
         self.use[self._contacts[owner], cases] = 1.0 + excess
         exact_normals = _normals(factors, points)
-        used = _normals(self._factors[owner, cases], per_unit)
         limiting = weights[owner, cases] > 0.0  # (a NaN normal elsewhere does not matter)
         weight = weights[owner, cases][limiting]
         gap = weight * _chord(used[limiting], exact_normals[limiting])

@@ -416,12 +416,18 @@ def _plane(load, units, twist, b1, b2):  # pragma: no cover - compiled
         twist[i] = d[i] / (length * units[i])
 
 
-def _solve_load(kernel, discrete, load, units, scale, twist):  # pragma: no cover - compiled
+def _solve_load(kernel, discrete, load, units, scale, twist, start):  # pragma: no cover
     """Safety factor of one nonzero ``load`` (its sliding twist [SI] in ``twist``) and, where
-    Newton stopped away from a minimum, its projected gradient relative to ``h`` (else 0)."""
+    Newton stopped away from a minimum, its projected gradient relative to ``h`` (else 0).
+    Newton starts from the twist ``start`` (scaled onto the plane ``L·V = 1``) where it does
+    positive work on the load, else from the ellipsoid's twist."""
     b1 = np.empty(3)
     b2 = np.empty(3)
     _plane(load, units, twist, b1, b2)
+    work = load[0] * start[0] + load[1] * start[1] + load[2] * start[2]
+    if work > 0.0 and math.isfinite(work):
+        for i in range(3):
+            twist[i] = start[i] / work
     stalled, h, kink = _newton(kernel, 0.0, twist, b1, b2, PROBES if discrete else SMOOTH)
     if kink >= 0:
         certified = _certify_kink(kernel, load, scale, twist, b1, b2, kink)
@@ -453,7 +459,7 @@ def _solve_load(kernel, discrete, load, units, scale, twist):  # pragma: no cove
 
 
 def _solve(
-    kernel, discrete, loads, units, scale, out_safety, out_twist, out_gradient
+    kernel, discrete, loads, units, scale, starts, out_safety, out_twist, out_gradient
 ):  # pragma: no cover
     for k in numba.prange(loads.shape[0]):
         # Solve for a load of unit size (normalised): s(c L) = s(L) / c.
@@ -466,7 +472,7 @@ def _solve(
             out_gradient[k] = 0.0
             continue
         safety, out_gradient[k] = _solve_load(
-            kernel, discrete, loads[k] / size, units, scale, out_twist[k]
+            kernel, discrete, loads[k] / size, units, scale, out_twist[k], starts[k]
         )
         out_safety[k] = safety / size
 
@@ -486,16 +492,15 @@ def _supports(kernel, twists, out):  # pragma: no cover - compiled
 
 def _hessians(kernel, twists, out):  # pragma: no cover - compiled
     """Support Hessians ``out`` ``(K, 3, 3)`` of the unit-friction ``kernel`` at ``twists``."""
-    local = np.empty(10)
-    terms = np.empty(10)
-    for k in range(twists.shape[0]):
+    for k in numba.prange(twists.shape[0]):
+        local = np.empty(10)
+        terms = np.empty(10)
         _terms(kernel, 0.0, twists[k], True, local, terms)
         _unpack(terms, out[k])
 
 
 _terms = compiled_scalar(_terms)
 _unpack = compiled_scalar(_unpack)
-_hessians = compiled_scalar(_hessians)
 _supports = compiled_scalar(_supports)
 _projected = compiled_scalar(_projected)
 _newton_step = compiled_scalar(_newton_step)
@@ -510,6 +515,7 @@ _continuation = compiled_scalar(_continuation)
 _plane = compiled_scalar(_plane)
 _solve_load = compiled_scalar(_solve_load)
 _SOLVE = _compiled(_solve)
+_HESSIANS = _compiled(_hessians)
 
 
 @dataclass(frozen=True, slots=True)
@@ -525,11 +531,18 @@ class CompiledKernel:
     work: int
 
     def solve(
-        self, loads: np.ndarray, units: np.ndarray, scale: float
+        self,
+        loads: np.ndarray,
+        units: np.ndarray,
+        scale: float,
+        start: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Safety factors ``(K,)`` and sliding twists ``(K, 3)`` [SI] of ``loads`` ``(K, 3)``
         [N, N m] (``inf`` and NaN for a zero load); ``units`` = ``(max_force, max_force,
         max_moment)`` normalise the coordinates and ``scale`` (``mu * N``) multiplies the kernel.
+        ``start`` ``(K, 3)`` are twists (any size) near the answers to start Newton from; rows
+        that do no positive work on their load start from the ellipsoid's twist, as all do
+        without it.
 
         Raises :class:`ConvergenceError` where Newton stopped away from a minimum.
         """
@@ -538,8 +551,10 @@ class CompiledKernel:
         twist = np.empty((count, 3))
         gradient = np.empty(count)
         loads = np.ascontiguousarray(loads, dtype=float)
+        # A zero start does no work on any load: Newton starts from the ellipsoid's twist.
+        starts = np.zeros((count, 3)) if start is None else np.array(start, dtype=float)
         _pick(_SOLVE, count, self.work)(
-            self.parts, self.discrete, loads, units, scale, safety, twist, gradient
+            self.parts, self.discrete, loads, units, scale, starts, safety, twist, gradient
         )
         worst = int(np.argmax(gradient)) if count > 1 else 0
         if gradient[worst] > INVERSE_GRADIENT_RTOL:
@@ -555,7 +570,8 @@ class CompiledKernel:
     def hessians(self, twists: np.ndarray) -> np.ndarray:
         """Hessians ``(K, 3, 3)`` of the unit-friction support at nonzero ``twists`` ``(K, 3)``."""
         out = np.empty((len(twists), 3, 3))
-        _hessians(self.parts, np.ascontiguousarray(twists, dtype=float), out)
+        twists = np.ascontiguousarray(twists, dtype=float)
+        _pick(_HESSIANS, len(twists), self.work)(self.parts, twists, out)
         return out
 
 
@@ -596,7 +612,7 @@ def compile_kernel(kernel: SupportKernel) -> CompiledKernel | None:
         table = np.array(kernel.table, dtype=float)
         reach = FAR_FIELD_RADII * kernel.size
         parts = (kind, *_point_columns(kernel.far), table, reach, transform, posed)
-        return CompiledKernel(parts=parts, discrete=False, work=table.shape[1])
+        return CompiledKernel(parts=parts, discrete=False, work=kernel.work)
     return None
 
 

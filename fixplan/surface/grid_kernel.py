@@ -155,6 +155,7 @@ class GridKernel(ClosedFormKernel):
     _table: np.ndarray = field(init=False, repr=False)
     _size: float = field(init=False, repr=False)
     _NEAR_SUMS = _NODE_SUMS
+    _TERM_WORK = 4  # 27-39 ns per node against 8.6 ns per point, Hessians included
 
     def __post_init__(self):
         columns = (np.asarray(self.nodes, dtype=float), np.asarray(self.kappa, dtype=float))

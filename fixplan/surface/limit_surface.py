@@ -293,13 +293,17 @@ class LimitSurface:
             twists[rows] = result.twist
         return safety, twists, single
 
-    def _trusted_inverse(self, loads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _trusted_inverse(
+        self, loads: np.ndarray, start: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Safety factors ``(K,)`` and sliding twists ``(K, 3)`` (SI, of any size) of nonzero
         finite loads ``(K, 3)`` [N, N m] from a caller that checked them (the planner's exact
         models, many times per solve): :meth:`motion_and_safety_factor` without the checks and
-        the twists' normalisation, which cost more than the compiled solve itself."""
+        the twists' normalisation, which cost more than the compiled solve itself. Compiled
+        kernels start Newton from the twists ``start`` ``(K, 3)`` where given (a guess: the
+        answers are those of any start, to Newton's tolerance)."""
         if self._compiled is not None and self._shape is None:
-            return self._compiled.solve(loads, self._units, self._scale)
+            return self._compiled.solve(loads, self._units, self._scale, start)
         safety, twists, _ = self._inverse(loads)
         return safety, twists
 

@@ -225,6 +225,15 @@ class GridField(PressureField):
         fractions = self.values[loaded] / self.values[loaded].sum()
         return centers, fractions
 
+    def center_of_pressure(self, mu: MuLike | None = None) -> np.ndarray:
+        """Centre of pressure ``(x, y)`` [m] in the contact frame (paper eq. 2): for a scalar
+        or no ``mu`` exactly, from the cells' centres, instead of from a Gauss rule of
+        ``DEFAULT_ORDER²`` points per cell (14 million points on a 200 x 200 grid)."""
+        if callable(mu):
+            return PressureField.center_of_pressure(self, mu)
+        centers, fractions = self.cells()
+        return self.pose.apply((fractions @ centers)[None, :])[0]
+
     def _local_quadrature(self, order):
         centers, fractions = self.cells()
         dx, dy = self.cell_size
