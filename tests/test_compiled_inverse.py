@@ -98,7 +98,6 @@ def test_the_compiled_path_gives_the_answers_of_the_numpy_path(name, how):
     surface = SURFACES[name]()
     assert surface._compiled is not None
     rng = np.random.default_rng(5)
-    rho = surface.characteristic_length
     for distribution, loads in distributions(surface, rng).items():
         expected_safety, expected_twists = numpy_path(surface, loads)
         if how == "single":
