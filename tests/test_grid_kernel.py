@@ -18,7 +18,7 @@ from fixplan import LimitSurface, pressure
 from fixplan.surface import limit_surface
 from fixplan.surface.grid_kernel import GridKernel
 from fixplan.surface.kernels import PosedKernel
-from fixplan.surface.point_kernel import PointSetKernel
+from fixplan.surface.point_kernel import PARALLEL_MIN_WORK, PointSetKernel
 from fixplan.surface.polygon_kernel import EdgeSumKernel
 from fixplan.tolerances import FAR_FIELD_RADII, INVERSE_RTOL
 
@@ -248,3 +248,22 @@ def test_safety_factors_and_motions_match_the_four_edges_per_cell_surface(name, 
     np.testing.assert_allclose(motion, motion_ref, rtol=0.0, atol=MOTION_ATOL)
     np.testing.assert_array_equal(surface.safety_factor(loads[:5]), safety[:5])
     np.testing.assert_array_equal(surface.motion(loads[:5]), motion[:5])
+
+
+def test_batches_large_enough_to_run_in_parallel_give_the_one_by_one_answers():
+    # A 120 x 150 Hertz map has about 10,000 loaded corners, each weighed as 4 points: a batch
+    # of 8 queries or Hessians crosses PARALLEL_MIN_WORK and runs on the thread pool. Each
+    # twist is computed alone either way, so the answers are the same to the bit.
+    surface = LimitSurface(GRIDS["Hertz map of 120 x 150 cells"](), mu=0.5, normal_force=20.0)
+    compiled = surface._compiled
+    assert 8 * compiled.work >= PARALLEL_MIN_WORK > compiled.work
+    rng = np.random.default_rng(9)
+    units = np.array([surface.max_force, surface.max_force, surface.max_moment])
+    loads = rng.normal(size=(8, 3)) * units
+    safety, twists = compiled.solve(loads, units, surface._scale)
+    hessians = compiled.hessians(twists)
+    for k in range(8):
+        alone = compiled.solve(loads[k : k + 1], units, surface._scale)
+        np.testing.assert_array_equal(alone[0], safety[k : k + 1])
+        np.testing.assert_array_equal(alone[1], twists[k : k + 1])
+        np.testing.assert_array_equal(compiled.hessians(twists[k : k + 1])[0], hessians[k])
