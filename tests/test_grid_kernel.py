@@ -182,7 +182,7 @@ def test_each_lattice_corner_is_kept_once_with_the_mixed_difference_of_its_cells
     ("name", "count"),
     [("uniform plateau", 4), ("one loaded cell", 4), ("one row of 7 cells", 2 * 8)],
 )
-def test_grids_keep_only_the_corners_where_the_pressure_is_not_bilinear_free(name, count):
+def test_grids_keep_only_the_corners_with_a_nonzero_mixed_difference(name, count):
     kernel = limit_surface._field_kernel(GRIDS[name]())
     assert kernel.table.shape[1] == count
 

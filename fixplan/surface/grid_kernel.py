@@ -14,7 +14,8 @@ Over a cell ``[x₀, x₁] × [y₀, y₁]`` of uniform pressure ``p`` the momen
 
 Cells share corners, so the whole grid is one sum over the corners (nodes) of the lattice, each
 with the mixed second difference ``κ`` of the cell pressures around it (the cells up-right and
-down-left minus the other two; zero inside a region of uniform or bilinear-free pressure):
+down-left minus the other two; zero inside a uniform region, and wherever the pressure is a
+function of x plus one of y; such corners are left out):
 ``M = Σ κ G``, ``∇M = -Σ κ (G_X, G_Y)``, ``∇²M = Σ κ [[G_XX, G_XY], [G_XY, G_YY]]``. Each node
 costs one square root and two logarithms; the edge sums of
 :mod:`~fixplan.surface.polygon_kernel` cost two square roots and two ``asinh`` per lattice edge,
