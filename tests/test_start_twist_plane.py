@@ -1,11 +1,12 @@
 """Start twists of the compiled inverse map (``CompiledKernel.solve(..., start)``) move where
 Newton starts, never the answer: the safety factor is ``scale * h`` on the plane ``L·V = 1``.
 
-``_solve_load`` puts a start on that plane by dividing it by its work ``L·S`` computed in
-floating point. Where that sum cancels (a start doing little work for its size) or its products
-are subnormal (a tiny start: "any size" is allowed), the quotient misses the plane by the
-rounding of ``L·S``; Newton then moves only along the plane's directions, so the final twist
-stays off it and ``scale * h`` is off by the same factor, with no error raised.
+A start put on that plane by dividing it by its work ``L·S`` misses the plane by the rounding
+of ``L·S`` where that sum cancels (a start doing little work for its size) or its products are
+subnormal (a tiny start: "any size" is allowed); Newton moves only along the plane's
+directions, so the twist would stay off it and ``scale * h`` be off by the same factor, with no
+error raised (as it was, found in review). Starts now only move the ellipsoid's twist, which is
+on the plane, along the plane.
 
 Reference: the same solve without a start (Newton from the ellipsoid's twist, which
 ``test_compiled_inverse`` pins to the NumPy path and ``test_grid_kernel`` to the four-edges
@@ -19,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fixplan import LimitSurface, pressure
+from fixplan import InvalidArgumentError, LimitSurface, pressure
 
 SAFETY_RTOL = 1e-12
 
@@ -84,3 +85,25 @@ def test_the_answers_scaled_to_a_tiny_size_give_the_answer(name):
     surface = SURFACES[name]()
     units, loads, expected, answers = loads_and_answers(surface)
     check(surface, units, loads, answers * 1e-320, expected)
+
+
+@pytest.mark.parametrize("name", sorted(SURFACES))
+def test_starts_that_are_not_finite_or_nearly_along_the_plane_are_not_used(name):
+    # Such rows start from the ellipsoid's twist: the answer comes out the same.
+    surface = SURFACES[name]()
+    units, loads, expected, answers = loads_and_answers(surface)
+    starts = answers.copy()
+    starts[0::4, 0] = np.nan
+    starts[1::4, 2] = np.inf
+    starts[2::4, 1] = -np.inf
+    # Row 3 of every 4: a twist doing no work on its load, plus a tiny share of the answer.
+    idle = np.cross(loads, [0.3, -0.2, 1.0])
+    starts[3::4] = idle[3::4] + 1e-9 * answers[3::4]
+    check(surface, units, loads, starts, expected)
+
+
+def test_a_start_of_the_wrong_shape_is_refused():
+    surface = SURFACES["hertz disk"]()
+    units, loads, _, answers = loads_and_answers(surface)
+    with pytest.raises(InvalidArgumentError, match=r"start must have the shape of the loads"):
+        surface._compiled.solve(loads, units, surface._scale, answers[:1])

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from fixplan.errors import ConvergenceError
+from fixplan.errors import ConvergenceError, InvalidArgumentError
 from fixplan.surface.disk_compiled import _DISK_TERMS, PROFILES
 from fixplan.surface.disk_kernel import AnnulusKernel, DiskKernel
 from fixplan.surface.grid_kernel import _NODE_TERMS, GridKernel
@@ -89,6 +89,11 @@ _ARMIJO = 1e-4
 
 #: The ridge added to the projected Hessian (relative to its trace) keeps it invertible.
 RIDGE = 1e-14
+
+#: Largest angle [rad] (normalised coordinates) between a start twist and its load's ray for
+#: Newton to start from it: a start nearly parallel to the plane ``L·V = 1`` meets it far out
+#: (10 times farther than the ellipsoid's twist at this angle, 84°).
+START_MAX_ANGLE = math.acos(0.1)
 
 
 def _terms(kernel, eps2, twist, with_hessian, local, out):  # pragma: no cover - compiled
@@ -416,18 +421,48 @@ def _plane(load, units, twist, b1, b2):  # pragma: no cover - compiled
         twist[i] = d[i] / (length * units[i])
 
 
+def _start_on_plane(units, start, twist, b1, b2):  # pragma: no cover - compiled
+    """Move ``twist`` (the ellipsoid's, on the plane ``L·V = 1``) within the plane to where the
+    ray of ``start`` meets it, if that ray is within :data:`START_MAX_ANGLE` of the load's
+    (normalised coordinates). Only the components along ``b1`` and ``b2`` are added: the twist
+    stays on the plane to rounding whatever the start's size."""
+    s = np.empty(3)
+    largest = 0.0
+    for i in range(3):
+        s[i] = start[i] * units[i]
+        if not math.isfinite(s[i]):
+            return
+        largest = max(largest, abs(s[i]))
+    if largest == 0.0:
+        return
+    s /= largest
+    t0 = np.empty(3)  # the ellipsoid's twist, normalised: the load's direction over its size
+    for i in range(3):
+        t0[i] = twist[i] * units[i]
+    along = s[0] * t0[0] + s[1] * t0[1] + s[2] * t0[2]
+    t0_squared = t0[0] * t0[0] + t0[1] * t0[1] + t0[2] * t0[2]
+    s_length = math.sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2])
+    if along <= math.cos(START_MAX_ANGLE) * s_length * math.sqrt(t0_squared):
+        return
+    stretch = t0_squared / along  # s * stretch is on the plane
+    alpha = 0.0
+    beta = 0.0
+    for i in range(3):
+        alpha += s[i] * stretch * b1[i] * units[i]
+        beta += s[i] * stretch * b2[i] * units[i]
+    for i in range(3):
+        twist[i] += alpha * b1[i] + beta * b2[i]
+
+
 def _solve_load(kernel, discrete, load, units, scale, twist, start):  # pragma: no cover
     """Safety factor of one nonzero ``load`` (its sliding twist [SI] in ``twist``) and, where
     Newton stopped away from a minimum, its projected gradient relative to ``h`` (else 0).
-    Newton starts from the twist ``start`` (scaled onto the plane ``L·V = 1``) where it does
-    positive work on the load, else from the ellipsoid's twist."""
+    Newton starts where the ray of ``start`` meets the plane ``L·V = 1``
+    (:func:`_start_on_plane`), else from the ellipsoid's twist."""
     b1 = np.empty(3)
     b2 = np.empty(3)
     _plane(load, units, twist, b1, b2)
-    work = load[0] * start[0] + load[1] * start[1] + load[2] * start[2]
-    if work > 0.0 and math.isfinite(work):
-        for i in range(3):
-            twist[i] = start[i] / work
+    _start_on_plane(units, start, twist, b1, b2)
     stalled, h, kink = _newton(kernel, 0.0, twist, b1, b2, PROBES if discrete else SMOOTH)
     if kink >= 0:
         certified = _certify_kink(kernel, load, scale, twist, b1, b2, kink)
@@ -513,6 +548,7 @@ _escape_kink = compiled_scalar(_escape_kink)
 _certify_kink = compiled_scalar(_certify_kink)
 _continuation = compiled_scalar(_continuation)
 _plane = compiled_scalar(_plane)
+_start_on_plane = compiled_scalar(_start_on_plane)
 _solve_load = compiled_scalar(_solve_load)
 _SOLVE = _compiled(_solve)
 _HESSIANS = _compiled(_hessians)
@@ -541,8 +577,8 @@ class CompiledKernel:
         [N, N m] (``inf`` and NaN for a zero load); ``units`` = ``(max_force, max_force,
         max_moment)`` normalise the coordinates and ``scale`` (``mu * N``) multiplies the kernel.
         ``start`` ``(K, 3)`` are twists (any size) near the answers to start Newton from; rows
-        that do no positive work on their load start from the ellipsoid's twist, as all do
-        without it.
+        more than :data:`START_MAX_ANGLE` from their load's ray (or not finite) start from the
+        ellipsoid's twist, as all do without it.
 
         Raises :class:`ConvergenceError` where Newton stopped away from a minimum.
         """
@@ -551,8 +587,12 @@ class CompiledKernel:
         twist = np.empty((count, 3))
         gradient = np.empty(count)
         loads = np.ascontiguousarray(loads, dtype=float)
-        # A zero start does no work on any load: Newton starts from the ellipsoid's twist.
+        # A zero start is none: Newton starts from the ellipsoid's twist.
         starts = np.zeros((count, 3)) if start is None else np.array(start, dtype=float)
+        if starts.shape != (count, 3):
+            raise InvalidArgumentError(
+                f"start must have the shape of the loads {(count, 3)}, got {starts.shape}"
+            )
         _pick(_SOLVE, count, self.work)(
             self.parts, self.discrete, loads, units, scale, starts, safety, twist, gradient
         )
