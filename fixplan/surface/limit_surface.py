@@ -429,7 +429,9 @@ def _field_kernel(field: PressureField) -> SupportKernel:
             PointSetKernel(far_points, far_weights / far_weights.sum()),
         )
     elif isinstance(field, GridField):
-        local = _grid_kernel(field)
+        local, middle = _grid_kernel(field)
+        offset = field.pose.apply(middle[None, :])[0]
+        return _posed(local, Pose(angle=field.pose.angle, offset=(offset[0], offset[1])))
     elif isinstance(field, PointsField):  # placed directly: no rounding from a twist transform
         return PointSetKernel(field.pose.apply(field.xy), field.weights, discrete=True)
     elif isinstance(field, FunctionField):
@@ -451,18 +453,30 @@ def _cell_squares(field: GridField) -> tuple[np.ndarray, np.ndarray]:
     return centers[:, None, :] + corners[None, :, :], fractions
 
 
-def _grid_kernel(field: GridField) -> GridKernel:
-    """The node kernel of a grid, with the cells' Gauss rule for far centres of rotation."""
+def _grid_kernel(field: GridField) -> tuple[GridKernel, np.ndarray]:
+    """The node kernel of a grid, with the cells' Gauss rule for far centres of rotation, and
+    the point ``(2,)`` [m] of the grid's local frame that is its origin.
+
+    That is the grid's own origin, unless it lies outside the grid (farther from the middle of
+    the grid than its corners: a grid not centred, placed away from the contact point): then
+    the middle, so that the far rule takes over at four sizes of the grid, not of its distance
+    from the origin (closer, the corner sums lose a digit per ten grid sizes).
+    """
     centers, fractions = field.cells()
     dx, dy = field.cell_size
     ny, nx = field.values.shape
+    middle = np.array([field.x[0] + field.x[-1], field.y[0] + field.y[-1]]) / 2.0
+    half_diagonal = np.hypot(field.x[-1] - field.x[0] + dx, field.y[-1] - field.y[0] + dy) / 2
+    if np.hypot(*middle) <= half_diagonal:
+        middle = np.zeros(2)
     pressure = np.zeros((ny, nx))
     pressure[field.values > 0.0] = fractions / (dx * dy)
-    corner_x = field.x[0] + (np.arange(nx + 1) - 0.5) * dx
-    corner_y = field.y[0] + (np.arange(ny + 1) - 0.5) * dy
+    corner_x = field.x[0] - middle[0] + (np.arange(nx + 1) - 0.5) * dx
+    corner_y = field.y[0] - middle[1] + (np.arange(ny + 1) - 0.5) * dy
     order = 8 if len(centers) <= 16 else 4 if len(centers) <= 256 else 3
-    far = PointSetKernel(*field._local_quadrature(order))
-    return GridKernel(*grid_nodes(corner_x, corner_y, pressure), far)
+    points, weights = field._local_quadrature(order)
+    far = PointSetKernel(points - middle, weights)
+    return GridKernel(*grid_nodes(corner_x, corner_y, pressure), far), middle
 
 
 def _regions(shape: DiskField | PolygonField) -> tuple:
