@@ -273,3 +273,33 @@ def test_the_reference_force_objective_agrees_with_the_production_planner(name):
     plan = fixplan.solve(problem)
     assert plan.status == "optimal"
     assert ref.min_force_objective(problem) == pytest.approx(plan.objective_value, rel=1e-6)
+
+
+def test_a_pinch_that_needs_forty_times_its_weight_is_found_feasible():
+    # Two fingers on one line beside the centre of mass (found by hypothesis): only the disk
+    # finger's torsion, (2/3) mu N R with R = 3.54 mm, holds the weight's moment about the
+    # grasp axis (19.6 N at 43 mm), so each finger needs about 800 N. The early certificate test
+    # once called this infeasible; the stacked planner (an independent formulation) finds and
+    # verifies the optimum, which the reference must match.
+    loads = [
+        Load(name="a", force=[6.84612432, -6.3498168, -0.4379184],
+             point=[-0.03140463, -0.03546699, -0.0306745]),
+        Load(name="b", force=[-2.2084272, -6.9407712, -1.577448],
+             point=[0.00575352, -0.04040439, -0.0308724]),
+        Load(name="c", force=[-3.52830384, 3.04988976, -10.37560536],
+             point=[-0.03020598, -0.03842943, 0.0037601]),
+        Load(name="d", force=[-4.53222, -3.35988576, -3.3840576],
+             point=[-0.01829939, -0.03077646, 0.0087076]),
+    ]  # fmt: skip
+    contacts = [
+        Contact(name="point", role="finger", position=[-0.04257605, -0.08229, -0.03170358],
+                normal=[0, 1, 0], mu=0.7942, model="point-cone"),
+        Contact(name="disk", role="finger", position=[-0.04257605, 0.08229, -0.03170358],
+                normal=[0, -1, 0], mu=0.4295, model="ellipsoid", patch=pressure.disk(0.00354)),
+    ]  # fmt: skip
+    problem = Problem(body=Body(mass=2.0, center_of_mass=[0, 0, 0]), contacts=contacts,
+                      loads=loads, objective="min-squared-normal-force")  # fmt: skip
+    plan = fixplan.Planner(problem).solve()
+    assert plan.status == "optimal" and all(plan.held.values())
+    assert np.all(plan.normal_forces > 700.0)
+    assert ref.min_force_objective(problem) == pytest.approx(plan.objective_value, rel=1e-7)
