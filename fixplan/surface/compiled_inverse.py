@@ -493,23 +493,45 @@ def _solve_load(kernel, discrete, load, units, scale, twist, start):  # pragma: 
     return safety, math.hypot(g1, g2) / terms[0]
 
 
+def _solve_row(
+    kernel, discrete, loads, units, scale, k, start, out_safety, out_twist, out_gradient
+):  # pragma: no cover - compiled
+    """Row ``k`` of :func:`_solve`: the answer of ``loads[k]``, Newton started from ``start``."""
+    # Solve for a load of unit size (normalised): s(c L) = s(L) / c.
+    size = 0.0
+    for i in range(3):
+        size = max(size, abs(loads[k, i] / units[i]))
+    if size == 0.0:
+        out_safety[k] = np.inf
+        out_twist[k, :] = np.nan
+        out_gradient[k] = 0.0
+        return
+    safety, out_gradient[k] = _solve_load(
+        kernel, discrete, loads[k] / size, units, scale, out_twist[k], start
+    )
+    out_safety[k] = safety / size
+
+
 def _solve(
-    kernel, discrete, loads, units, scale, starts, out_safety, out_twist, out_gradient
-):  # pragma: no cover
+    kernel, discrete, loads, units, scale, out_safety, out_twist, out_gradient
+):  # pragma: no cover - compiled
+    """Safety factors, twists and (where Newton stalled) relative gradients of ``loads``."""
+    start = np.zeros(3)  # none (read only): Newton starts from the ellipsoid's twist
     for k in numba.prange(loads.shape[0]):
-        # Solve for a load of unit size (normalised): s(c L) = s(L) / c.
-        size = 0.0
-        for i in range(3):
-            size = max(size, abs(loads[k, i] / units[i]))
-        if size == 0.0:
-            out_safety[k] = np.inf
-            out_twist[k, :] = np.nan
-            out_gradient[k] = 0.0
-            continue
-        safety, out_gradient[k] = _solve_load(
-            kernel, discrete, loads[k] / size, units, scale, out_twist[k], starts[k]
+        _solve_row(
+            kernel, discrete, loads, units, scale, k, start, out_safety, out_twist, out_gradient
         )
-        out_safety[k] = safety / size
+
+
+def _solve_from(
+    kernel, discrete, loads, units, scale, starts, out_safety, out_twist, out_gradient
+):  # pragma: no cover - compiled
+    """:func:`_solve` with Newton started from ``starts`` (a separate loop: the extra argument
+    costs a single query about a microsecond)."""
+    for k in numba.prange(loads.shape[0]):
+        _solve_row(
+            kernel, discrete, loads, units, scale, k, starts[k], out_safety, out_twist, out_gradient
+        )
 
 
 def _supports(kernel, twists, out):  # pragma: no cover - compiled
@@ -550,7 +572,9 @@ _continuation = compiled_scalar(_continuation)
 _plane = compiled_scalar(_plane)
 _start_on_plane = compiled_scalar(_start_on_plane)
 _solve_load = compiled_scalar(_solve_load)
+_solve_row = compiled_scalar(_solve_row)
 _SOLVE = _compiled(_solve)
+_SOLVE_FROM = _compiled(_solve_from)
 _HESSIANS = _compiled(_hessians)
 
 
@@ -587,15 +611,19 @@ class CompiledKernel:
         twist = np.empty((count, 3))
         gradient = np.empty(count)
         loads = np.ascontiguousarray(loads, dtype=float)
-        # A zero start is none: Newton starts from the ellipsoid's twist.
-        starts = np.zeros((count, 3)) if start is None else np.array(start, dtype=float)
-        if starts.shape != (count, 3):
-            raise InvalidArgumentError(
-                f"start must have the shape of the loads {(count, 3)}, got {starts.shape}"
+        if start is None:
+            _pick(_SOLVE, count, self.work)(
+                self.parts, self.discrete, loads, units, scale, safety, twist, gradient
             )
-        _pick(_SOLVE, count, self.work)(
-            self.parts, self.discrete, loads, units, scale, starts, safety, twist, gradient
-        )
+        else:
+            starts = np.array(start, dtype=float)
+            if starts.shape != (count, 3):
+                raise InvalidArgumentError(
+                    f"start must have the shape of the loads {(count, 3)}, got {starts.shape}"
+                )
+            _pick(_SOLVE_FROM, count, self.work)(
+                self.parts, self.discrete, loads, units, scale, starts, safety, twist, gradient
+            )
         worst = int(np.argmax(gradient)) if count > 1 else 0
         if gradient[worst] > INVERSE_GRADIENT_RTOL:
             raise not_converged(loads[worst], float(gradient[worst]))
