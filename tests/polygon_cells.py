@@ -5,9 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from fixplan.surface.closed_form import EdgeSumKernel
 from fixplan.surface.geometry import signed_area, triangulate
 from fixplan.surface.point_kernel import PointSetKernel
-from fixplan.surface.polygon_kernel import EdgeSumKernel, polygon_edges
+from fixplan.surface.polygon_kernel import polygon_edges
 from fixplan.surface.rules import triangle_rule
 
 

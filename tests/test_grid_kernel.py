@@ -16,10 +16,9 @@ import pytest
 
 from fixplan import LimitSurface, pressure
 from fixplan.surface import limit_surface
-from fixplan.surface.grid_kernel import GridKernel
+from fixplan.surface.closed_form import EdgeSumKernel, GridKernel
 from fixplan.surface.kernels import PosedKernel
 from fixplan.surface.point_kernel import PARALLEL_MIN_WORK, PointSetKernel
-from fixplan.surface.polygon_kernel import EdgeSumKernel
 from fixplan.tolerances import FAR_FIELD_RADII, INVERSE_RTOL
 
 #: Node against edge kernel, per twist: support value relative to itself, load and Hessian

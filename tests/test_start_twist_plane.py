@@ -19,28 +19,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import SURFACES as SHARED_SURFACES
 
-from fixplan import InvalidArgumentError, LimitSurface, pressure
+from fixplan import InvalidArgumentError
 
 SAFETY_RTOL = 1e-12
 
-SURFACES = {
-    "tactile grid": lambda: LimitSurface(
-        pressure.grid(
-            [-0.006, -0.002, 0.002, 0.006],
-            [-0.004, 0.0, 0.004],
-            [[0.2, 1.0, 0.0, 0.1], [0.5, 3.0, 2.0, 1.0], [1.0, 0.0, 1.0, 2.5]],
-        ),
-        mu=0.8,
-        normal_force=6.0,
-    ),
-    "hertz disk": lambda: LimitSurface(pressure.disk(0.01, "hertz"), mu=0.5, normal_force=20.0),
-    "three points": lambda: LimitSurface(
-        pressure.points([[0.0, 0.0], [0.04, 0.01], [0.01, 0.03]], [2.0, 1.0, 1.5]),
-        mu=0.7,
-        normal_force=5.0,
-    ),
-}
+SURFACES = {name: SHARED_SURFACES[name] for name in ("tactile grid", "hertz disk", "three points")}
 
 
 def loads_and_answers(surface):

@@ -8,8 +8,8 @@ iteration is gone (a few microseconds per query on a few points instead of half 
 
 Kernels are passed as a tuple ``(kind, x, y, weights, edges, reach, transform, posed)``: points
 ``x``, ``y`` [m] with friction ``weights`` (the far-field rule of a polygon or grid), the
-polygon's edge table ``(7, E)`` (``kind`` :data:`EDGES`) or the grid's node table ``(3, N)``
-(``kind`` :data:`NODES`) with its far-field radius ``reach`` [m], or the disk table ``(3, D)``
+polygon's edge table ``(7, E)`` (``kind`` :data:`~fixplan.surface.closed_form.EDGES`) or the grid's node table ``(3, N)``
+(``kind`` :data:`~fixplan.surface.closed_form.NODES`) with its far-field radius ``reach`` [m], or the disk table ``(3, D)``
 in its place (``kind`` :data:`DISKS`), and the ``transform`` (3x3) from contact-frame to local
 twists when ``posed``.
 
@@ -30,9 +30,9 @@ import numba
 import numpy as np
 
 from fixplan.errors import ConvergenceError, InvalidArgumentError
+from fixplan.surface.closed_form import _NEAR_TERMS, ClosedFormKernel
 from fixplan.surface.disk_compiled import _DISK_TERMS, PROFILES
 from fixplan.surface.disk_kernel import AnnulusKernel, DiskKernel
-from fixplan.surface.grid_kernel import _NODE_TERMS, GridKernel
 from fixplan.surface.kernels import PosedKernel, SupportKernel, twist_to_local
 from fixplan.surface.point_kernel import (
     _POINT_TERMS,
@@ -41,7 +41,6 @@ from fixplan.surface.point_kernel import (
     _pick,
     compiled_scalar,
 )
-from fixplan.surface.polygon_kernel import _EDGE_TERMS, EdgeSumKernel
 from fixplan.tolerances import (
     FACET_RTOL,
     FAR_FIELD_RADII,
@@ -53,9 +52,8 @@ from fixplan.tolerances import (
 #: Kinds of compiled kernels: weighted points, polygon edges or grid nodes with a far-field
 #: point rule, or closed-form disks.
 POINTS = 0
-EDGES = 1
 DISKS = 2
-NODES = 3
+# EDGES = 1 and NODES = 3: see fixplan.surface.closed_form.
 
 #: Number of nearest support points whose facets are tested per query.
 FACETS_TESTED = 3
@@ -113,10 +111,7 @@ def _terms(kernel, eps2, twist, with_hessian, local, out):  # pragma: no cover -
     if kind == DISKS:
         _DISK_TERMS(edges, vx, vy, w, with_hessian, target)
     elif kind != POINTS and abs(w) * reach > math.sqrt(vx * vx + vy * vy):
-        if kind == EDGES:
-            _EDGE_TERMS(edges, vx, vy, w, with_hessian, target)
-        else:
-            _NODE_TERMS(edges, vx, vy, w, with_hessian, target)
+        _NEAR_TERMS(kind, edges, vx, vy, w, with_hessian, target)
     else:
         _POINT_TERMS(px, py, pw, eps2, vx, vy, w, with_hessian, target)
     if not posed:
@@ -675,11 +670,10 @@ def compile_kernel(kernel: SupportKernel) -> CompiledKernel | None:
             return None  # facets are tested in the contact frame
         parts = (POINTS, *_point_columns(kernel), no_edges, 0.0, transform, posed)
         return CompiledKernel(parts=parts, discrete=kernel.discrete, work=len(kernel.weights))
-    if isinstance(kernel, EdgeSumKernel | GridKernel):
-        kind = EDGES if isinstance(kernel, EdgeSumKernel) else NODES
+    if isinstance(kernel, ClosedFormKernel):
         table = np.array(kernel.table, dtype=float)
         reach = FAR_FIELD_RADII * kernel.size
-        parts = (kind, *_point_columns(kernel.far), table, reach, transform, posed)
+        parts = (kernel._KIND, *_point_columns(kernel.far), table, reach, transform, posed)
         return CompiledKernel(parts=parts, discrete=False, work=kernel.work)
     return None
 

@@ -27,18 +27,11 @@ the Gauss rule of the cells as there.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
-import numba
 import numpy as np
 
-from fixplan.surface.point_kernel import (
-    _UNPACK_HESSIAN,
-    PointSetKernel,
-    _compiled,
-    compiled_scalar,
-)
-from fixplan.surface.polygon_kernel import ClosedFormKernel
+from fixplan.surface.point_kernel import compiled_scalar
+from fixplan.surface.polygon_kernel import _SUPPORT_TERMS
 
 #: Below this fraction of ``R``, ``|X|`` (or ``|Y|``) is taken as zero in ``asinh(Y/|X|)``: the
 #: terms carrying it (``X A``, ``X² A``, ``X³ A``) are then below ``1e-28 R`` and the quotient
@@ -82,50 +75,10 @@ def node_terms(nodes, vx, vy, w, with_hessian, out):  # pragma: no cover - compi
             m00 += k * xa
             m01 += k * r
             m11 += k * yb
-    sign = 1.0 if w > 0.0 else -1.0
-    out[0] = abs(w) * moment
-    out[1] = sign * gy
-    out[2] = -sign * gx
-    out[3] = sign * (moment - cx * gx - cy * gy)
-    if with_hessian:
-        s = 1.0 / abs(w)
-        out[4] = s * m11
-        out[5] = -s * m01
-        out[6] = -s * (m01 * cx + m11 * cy)
-        out[7] = s * m00
-        out[8] = s * (m00 * cx + m01 * cy)
-        out[9] = s * (m00 * cx * cx + 2.0 * m01 * cx * cy + m11 * cy * cy)
+    _SUPPORT_TERMS(moment, gx, gy, m00, m01, m11, vx, vy, w, with_hessian, out)
 
 
 _NODE_TERMS = compiled_scalar(node_terms)
-
-
-def _node_sums(  # pragma: no cover - compiled
-    nodes, reach, twists, with_hessian, out_h, out_g, out_hess, out_far
-):
-    """Support values ``out_h``, loads ``out_g`` and, ``with_hessian``, Hessians ``out_hess`` of
-    the twists whose centre of rotation lies within ``reach`` [m] (:func:`node_terms`);
-    ``out_far`` marks the others (their rows are left unset), whose number is returned."""
-    far_count = 0
-    for k in numba.prange(twists.shape[0]):
-        vx, vy, w = twists[k, 0], twists[k, 1], twists[k, 2]
-        far = abs(w) * reach <= math.sqrt(vx * vx + vy * vy)
-        out_far[k] = far
-        if far:
-            far_count += 1
-            continue
-        out = np.empty(10)
-        _NODE_TERMS(nodes, vx, vy, w, with_hessian, out)
-        out_h[k] = out[0]
-        out_g[k, 0] = out[1]
-        out_g[k, 1] = out[2]
-        out_g[k, 2] = out[3]
-        if with_hessian:
-            _UNPACK_HESSIAN(out, out_hess[k])
-    return far_count
-
-
-_NODE_SUMS = _compiled(_node_sums)
 
 
 def grid_nodes(
@@ -138,27 +91,3 @@ def grid_nodes(
     kappa = padded[1:, 1:] + padded[:-1, :-1] - padded[1:, :-1] - padded[:-1, 1:]
     rows, columns = np.nonzero(kappa)
     return np.column_stack([corner_x[columns], corner_y[rows]]), kappa[rows, columns]
-
-
-@dataclass(frozen=True, slots=True)
-class GridKernel(ClosedFormKernel):
-    """Unit-friction support function of a grid of uniform cells given by its nodes.
-
-    ``nodes`` ``(N, 2)`` [m] are corners of the cell lattice with mixed pressure differences
-    ``kappa`` ``(N,)`` [1/m²] (:func:`grid_nodes`; pressures normalised to unit total force),
-    and ``far`` a Gauss rule of the cells for far centres of rotation. Its :attr:`table`
-    ``(3, N)`` holds the nodes' x, y and ``κ`` (:func:`node_terms`).
-    """
-
-    nodes: np.ndarray
-    kappa: np.ndarray
-    far: PointSetKernel
-    _table: np.ndarray = field(init=False, repr=False)
-    _size: float = field(init=False, repr=False)
-    _NEAR_SUMS = _NODE_SUMS
-    _TERM_WORK = 4  # 27-39 ns per node against 8.6 ns per point, Hessians included
-
-    def __post_init__(self):
-        columns = (np.asarray(self.nodes, dtype=float), np.asarray(self.kappa, dtype=float))
-        object.__setattr__(self, "_table", np.ascontiguousarray(np.column_stack(columns).T))
-        object.__setattr__(self, "_size", self.far.size)

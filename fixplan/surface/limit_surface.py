@@ -39,14 +39,15 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError
+from fixplan.surface.closed_form import EdgeSumKernel, GridKernel
 from fixplan.surface.compiled_inverse import compile_kernel
 from fixplan.surface.disk_kernel import AnnulusKernel, DiskKernel
 from fixplan.surface.geometry import Pose, triangulate
-from fixplan.surface.grid_kernel import GridKernel, grid_nodes
+from fixplan.surface.grid_kernel import grid_nodes
 from fixplan.surface.inverse import solve
 from fixplan.surface.kernels import PosedKernel, SumKernel, SupportKernel
 from fixplan.surface.point_kernel import PointSetKernel
-from fixplan.surface.polygon_kernel import EdgeSumKernel, polygon_edges
+from fixplan.surface.polygon_kernel import polygon_edges
 from fixplan.surface.pressure import (
     DiskField,
     FunctionField,
