@@ -22,6 +22,7 @@ import numpy as np
 from fixplan.planner.friction_use import FrictionUse
 from fixplan.planner.problem import Problem
 from fixplan.planner.screw import Screw
+from fixplan.planner.verify import LARGEST_MAGNITUDE
 from fixplan.surface.point_kernel import compiled_scalar
 from fixplan.tolerances import (
     CAP_RTOL,
@@ -60,7 +61,7 @@ def analyse_cases(
         for j, twist in zip(moving, twists.T, strict=True):
             if twist.any():
                 motions[names[j]] = Screw.from_twist(twist, length_scale)
-    noise = FRICTION_SET_RTOL * max(float(np.abs(normal).max()), 1e-12)
+    noise = FRICTION_SET_RTOL * max(LARGEST_MAGNITUDE(normal), 1e-12)
     known = highest.get("known_use")
     utilisation = np.minimum(friction_use(friction, normal, noise=noise, known=known), 1.0)
     return {

@@ -64,7 +64,9 @@ class DirectSolver:
         ]
         self._equalities = equalities
         self._sign = -1.0 if isinstance(problem.objective, cp.Maximize) else 1.0  # of the value
-        self.objective_value = float("nan")
+        #: The last solve's value: ``(q, x, constant)`` of a linear program (its value taken
+        #: when asked), or ``(None, None, value)`` from Clarabel (see :attr:`objective_value`).
+        self._optimum = (None, None, float("nan"))
         #: Clarabel's status of the last solve.
         self.status = ""
         self._dual = np.zeros(0)
@@ -115,9 +117,22 @@ class DirectSolver:
         """The parameter vector of the parameters' current values (the last entry 1)."""
         return self._program.parameter_vector()
 
-    def entries(self, parameter: cp.Parameter) -> slice:
-        """Where ``parameter``'s values sit in the parameter vector (column-major)."""
-        return self._program.entries(parameter)
+    @property
+    def objective_value(self) -> float:
+        """The objective's value at the last solve (NaN before one)."""
+        q, x, value = self._optimum  # (value: the constant of the minimisation cvxpy compiled)
+        return self._sign * (value if x is None else float(q @ x) + value)
+
+    def write(self, vector: np.ndarray, parameter: cp.Parameter, value) -> None:
+        """Put ``parameter``'s ``value`` (broadcast to its shape) into the parameter ``vector``
+        (:meth:`parameter_vector`'s layout) instead of into ``parameter``; a parameter that the
+        compiled program does not use is left out."""
+        entries = self._program.entries(parameter)
+        if entries is None:
+            return
+        if np.shape(value) != parameter.shape:  # (broadcast_to costs 5-8 µs; most fit)
+            value = np.broadcast_to(value, parameter.shape)
+        vector[entries] = np.ravel(value, order="F")
 
     def solve(
         self, *, accept_inaccurate: bool = False, vector: np.ndarray | None = None
@@ -137,7 +152,7 @@ class DirectSolver:
         found = self._simplex_solve(q, a, b)
         if found is not None:
             x, self._dual = found
-            value = float(q @ x)
+            self._optimum = (q, x, constant)
             self.status, self.method = "Solved", "dual simplex"
         else:
             update = {"q": q, "b": b}
@@ -150,9 +165,7 @@ class DirectSolver:
             if not (solved or (accept_inaccurate and self.status == "AlmostSolved")):
                 return None
             x, self._dual = np.asarray(solution.x), np.asarray(solution.z)
-            value = float(solution.obj_val)
-        value += constant  # of the minimisation cvxpy compiled
-        self.objective_value = self._sign * value
+            self._optimum = (None, None, float(solution.obj_val) + constant)
         return {
             key: x[start:stop].reshape(shape, order="F")
             for key, start, stop, shape in self._placement
@@ -237,6 +250,7 @@ class _Program:
 
     def __init__(self, program, parameters):
         self._columns = [(p, program.param_id_to_col[p.id], p.size) for p in parameters]
+        self._entries = {p.id: slice(column, column + size) for p, column, size in self._columns}
         self._size = program.total_param_size + 1  # the last entry is the constant 1
         self._variables = program.x.size
         # The parameter vector with every parameter 0: a map applied to it is its constant part.
@@ -265,7 +279,14 @@ class _Program:
         self._fixed_values = None
         if self.fixed_a:
             self._fixed_values = -(a_map[: self._split] @ constant)
-            self._b_map = _for_products(a_map[self._split :])
+            # b's map with a row for every row of A, so that one product gives b.
+            placed = a_map[self._split :].tocoo()
+            rows = self._a_rows[self._split :][placed.row]
+            self._b_map = _for_products(
+                sp.csr_array(
+                    (placed.data, (rows, placed.col)), shape=(self._a_shape[0], self._size)
+                )
+            )
         if program.reduced_P is None or program.reduced_P.matrix_data is None:
             self.quadratic = sp.csc_matrix((self._variables, self._variables))
             self.parametric_p = False
@@ -285,12 +306,9 @@ class _Program:
             vector[column : column + size] = np.ravel(parameter.value, order="F")
         return vector
 
-    def entries(self, parameter) -> slice:
-        """Where ``parameter``'s values sit in the parameter vector."""
-        for known, column, size in self._columns:
-            if known is parameter:
-                return slice(column, column + size)
-        raise KeyError(parameter.name())
+    def entries(self, parameter) -> slice | None:
+        """Where ``parameter``'s values sit in the parameter vector (``None``: not used)."""
+        return self._entries.get(parameter.id)
 
     def cost(self, vector) -> tuple[np.ndarray, float]:
         """``q`` and the constant of the cost."""
@@ -302,10 +320,9 @@ class _Program:
     def constraints(self, vector) -> tuple[np.ndarray, np.ndarray]:
         """Clarabel's ``A`` as its values in the fixed pattern (:meth:`matrix`) and ``b``:
         cvxpy's ``A x + b`` in the cones is ``b_C - A_C x`` with ``A_C = -A``, ``b_C = b``."""
-        b = np.zeros(self._a_shape[0])
         if self._fixed_values is not None:
-            b[self._a_rows[self._split :]] = self._b_map @ vector
-            return self._fixed_values, b
+            return self._fixed_values, self._b_map @ vector
+        b = np.zeros(self._a_shape[0])
         values = self._a_map @ vector
         b[self._a_rows[self._split :]] = values[self._split :]
         return -values[: self._split], b

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import dataclass
 
 import cvxpy as cp
 import numpy as np
@@ -125,6 +126,7 @@ class Runner:
         self._solves: dict[tuple, int] = {}
         self._given: dict[tuple, tuple | None] = {}  # (unit, given forces) last set, if scalars
         self._units: dict[tuple, float] = {}  # the force unit [N] each problem was last set in
+        self._kept: dict[tuple, _Kept] = {}  # see _again
         # Task torques over the longest lever [m] of a contact's normal force are forces.
         lever = max(float(np.linalg.norm(layout.normal_map[3:], axis=0).max()), 1e-3)
         self._per_force = np.repeat([1.0, 1.0 / lever], 3)[:, None]  # task wrench -> forces
@@ -228,41 +230,58 @@ class Runner:
         self, objective, wrenches, given, order, numbers, sense, disabled, progress
     ) -> list[tuple[dict, int]]:
         """The results of the cases of a linear fixed-force objective whose given forces are
-        plain numbers, one by one in ``order``, each straight through the direct solver with
-        its parameter vector written here: the given forces set once per force unit, only the
-        task wrench per case. (`check` of fixture-321 × 1,000: 1.2-1.5× the cases per second of
-        :meth:`_run_block` per case, in alternating solves.) A case the direct solver does not solve, and
-        those before it exists, take that path (a case the direct solver failed on without
-        trying it again: a second try would count as a second missed warm start of the
-        simplex)."""
-        key = (objective, False)
-        stacked = self.stacked(*key)
-        results, set_in = [], None  # set_in: the unit the parameters were set in
+        plain numbers, one by one in ``order``, each through :meth:`_again` where it applies
+        (after the first case, the given forces are written once per force unit and then only
+        the task wrench per case), else through :meth:`_run_block`."""
+        results = []
         for position, j in enumerate(order):
-            direct = self._direct.get(key)
-            unit = self._force_unit(wrenches[:, j : j + 1], given)
-            result = None
-            if direct is not None:
-                if set_in != unit:
-                    self._set_parameters(key, stacked, wrenches[:, j : j + 1] / unit, given,
-                                         sense, None, disabled, unit)  # fmt: skip
-                    vector, set_in = direct.parameter_vector(), unit
-                    task = direct.entries(stacked.task)
-                vector[task] = wrenches[:, j] / unit
-                result = self._direct_result(key, stacked, vector)
+            wrench = wrenches[:, j : j + 1]
+            tried, result = self._again(objective, wrench, given, sense, None, disabled)
             if result is None:
                 result = self._run_block(
                     objective, *_block_of(order[position : position + 1], 1, wrenches, given,
                                           None, numbers), sense, False, disabled,
-                    direct_failed=direct is not None,
+                    direct_failed=tried,
                 )  # fmt: skip
-                set_in = None  # (that path set the parameters)
-            else:
-                result = _in_newtons(result, unit, objective)
             results.append((result, 1))
             if progress is not None:
                 progress(position + 1, len(order))
         return results
+
+    def _again(self, objective, wrenches, given, sense, unloaded, disabled) -> tuple:
+        """A block straight through the direct solver of ``objective``, its parameters written
+        into the parameter vector of its last direct solve (:class:`_Kept`) rather than set
+        through cvxpy: the task wrenches, and the given forces (also set, see ``put``) and
+        ``sense`` where they changed.
+        Applies where that solve was in the same force unit, with the same contacts disabled
+        and none ``unloaded``. Returns ``(tried, result)``: whether the direct solver was
+        tried, and the result in newtons (``None`` where it did not apply or failed: the caller
+        then takes the full path, :meth:`_solve_block`)."""
+        key = (objective, False)
+        kept = self._kept.get(key)
+        if kept is None or unloaded is not None or kept.disabled != _bytes(disabled):
+            return False, None
+        unit = self._force_unit(wrenches, given)
+        if unit != kept.unit:
+            return False, None
+        stacked, direct = self._built[key], self._direct[key]
+        vector = kept.vector
+        direct.write(vector, stacked.task, wrenches / unit)
+        state = _given_state(given)
+        if state is None or state != kept.given:
+            # Into the Parameters too: the plan's normal forces read the given ones from there.
+            def put(parameter, value):
+                assign(parameter, value)
+                direct.write(vector, parameter, value)
+
+            set_given(stacked, given, wrenches.shape[1], unit, put=put)
+            kept.given = state
+            self._given[key] = None if state is None else (unit, state)
+        if stacked.sense is not None and sense != kept.sense:
+            direct.write(vector, stacked.sense, float(sense))
+            kept.sense = sense
+        result = self._direct_result(key, stacked, vector)
+        return True, None if result is None else _in_newtons(result, unit, objective)
 
     def _run_block(
         self, objective, wrenches, given, unloaded, numbers, sense, accurate, disabled,
@@ -365,6 +384,12 @@ class Runner:
         ``fallback``, a solver failure is returned as it is (no retry with another solver);
         with ``direct_failed`` (the direct solver failed on these parameters just before),
         straight to the solve that :meth:`_direct_result` would have preceded."""
+        if not (accurate or direct_failed or self.osculating):
+            direct_failed, result = self._again(
+                objective, wrenches, given, sense, unloaded, disabled
+            )
+            if result is not None:
+                return result
         unit = self._force_unit(wrenches, given)
         for osculating in (True, False) if self.osculating else (False,):
             key = (objective, osculating)
@@ -376,9 +401,14 @@ class Runner:
             # a missed warm start (see :mod:`fixplan.planner.dual_simplex`).
             tried = direct_failed and not osculating
             if not (accurate or exact or tried):
-                direct = self._direct_result(key, stacked)
-                if direct is not None:
-                    return _in_newtons(direct, unit, objective)
+                direct = self._direct.get(key)
+                vector = None if direct is None else direct.parameter_vector()
+                result = None if direct is None else self._direct_result(key, stacked, vector)
+                if result is not None:
+                    if unloaded is None and not osculating:
+                        self._kept[key] = _Kept(unit, _bytes(disabled), _given_state(given),
+                                                float(sense), vector)  # fmt: skip
+                    return _in_newtons(result, unit, objective)
                 tried = key in self._direct
             if osculating:
                 cases = [(objective, sense, n, wrenches[:, j]) for j, n in enumerate(numbers)]
@@ -441,8 +471,8 @@ class Runner:
         if self._units.get(key) != unit:
             set_units(stacked, self.problem.body.weight_wrench, unit)
             self._units[key] = unit
-        scalars = tuple((i, v) for i, v in given.items() if isinstance(v, float))
-        state = (unit, scalars) if len(scalars) == len(given) else None
+        scalars = _given_state(given)
+        state = None if scalars is None else (unit, scalars)
         if state is None or self._given.get(key) != state:
             set_given(stacked, given, wrenches.shape[1], unit)  # (not again for the same forces)
             self._given[key] = state
@@ -533,6 +563,31 @@ class Runner:
         self._solves[key] = self._solves.get(key, 0) + 1
         if self._solves[key] >= 2:
             self._direct[key] = DirectSolver.create(stacked.problem, _SOLVER_OPTIONS["CLARABEL"])
+
+
+@dataclass(slots=True)
+class _Kept:
+    """The parameter ``vector`` of an objective's last direct solve (none unloaded), and what
+    it was set for: the force ``unit`` [N], the ``disabled`` contacts (:func:`_bytes`), the
+    ``given`` forces (:func:`_given_state`; ``None``: arrays) and the ``sense``."""
+
+    unit: float
+    disabled: bytes | None
+    given: tuple | None
+    sense: float
+    vector: np.ndarray
+
+
+def _bytes(disabled: np.ndarray | None) -> bytes | None:
+    return None if disabled is None else disabled.tobytes()
+
+
+def _given_state(given: dict) -> tuple | None:
+    """Given forces that are plain numbers as a comparable tuple; ``None`` if any is an array."""
+    if not given:
+        return ()
+    scalars = tuple((i, v) for i, v in given.items() if isinstance(v, float))
+    return scalars if len(scalars) == len(given) else None
 
 
 #: Up to this many cases are ordered by nearest neighbours (quadratic time); more by angle.

@@ -17,6 +17,7 @@ faster (20 contacts × 100 cases ran out of memory).
 from __future__ import annotations
 
 import itertools
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import cvxpy as cp
@@ -379,9 +380,12 @@ def set_units(stacked: Stacked, weight_wrench: np.ndarray, unit: float = 1.0) ->
         assign(parameter, forces / unit)
 
 
-def set_given(stacked: Stacked, values: dict, cases: int, unit: float = 1.0) -> None:
+def set_given(
+    stacked: Stacked, values: dict, cases: int, unit: float = 1.0, put: Callable = assign
+) -> None:
     """Set the given normal forces [N] in the force ``unit`` [N] of the program: ``values``
-    maps contact index -> float or ``(cases,)``."""
+    maps contact index -> float or ``(cases,)``; through ``put(parameter, value)`` (default
+    :func:`~fixplan.planner.parameters.assign`)."""
     fingers, clamps = stacked.given_fingers, stacked.given_clamps
     finger_values = None if fingers is None else np.zeros(fingers.shape)
     clamp_values = None if clamps is None else np.zeros(clamps.shape)
@@ -393,6 +397,6 @@ def set_given(stacked: Stacked, values: dict, cases: int, unit: float = 1.0) -> 
         else:
             clamp_values[row] = float(np.ravel(value)[0])
     if fingers is not None:
-        assign(fingers, finger_values)
+        put(fingers, finger_values)
     if clamps is not None:
-        assign(clamps, clamp_values)
+        put(clamps, clamp_values)

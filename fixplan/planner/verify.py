@@ -52,10 +52,9 @@ class Verifier:
         normal, friction, scale = answer["normal"], answer["friction"], answer["scale"]
         sizes = np.empty((2, normal.shape[1]))
         ratios = np.empty((2, normal.shape[1]))
-        _EQUILIBRIUM(*self._maps, normal, friction, wrenches, scale, self._gravity,
-                     self._length_scale, sizes, ratios)  # fmt: skip
+        relative = _EQUILIBRIUM(*self._maps, normal, friction, wrenches, scale, self._gravity,
+                                self._length_scale, sizes, ratios)  # fmt: skip
         problems = []
-        relative = float(ratios.max(initial=0.0))
         if relative > EQUILIBRIUM_RTOL:
             for row, unit in ((0, "N"), (1, "N m")):
                 worst = int(np.argmax(ratios[row]))
@@ -72,7 +71,7 @@ class Verifier:
     def _friction_problems(self, normal, friction, known) -> list[str]:
         """Pulling contacts, friction without normal force and friction outside its set
         (``known``: the uses already computed for some contacts, see :class:`FrictionUse`)."""
-        scale_force = max(float(np.abs(normal).max()), 1e-12)
+        scale_force = max(LARGEST_MAGNITUDE(normal), 1e-12)
         noise = FRICTION_SET_RTOL * scale_force
         use = self._use(friction, normal, noise=noise, known=known)
         if not _TROUBLED(normal, use, noise):
@@ -105,7 +104,8 @@ def equilibrium(normal_map, friction_map, normal, friction, wrenches, scale, gra
                 length_scale, sizes, ratios):  # fmt: skip  # pragma: no cover - compiled
     """Each case's largest residual of force and of moment (rows of ``ratios`` ``(2, K)``)
     over the size of its wrench terms (``sizes``: the largest force and moment of any term,
-    moments at least force × ``length_scale``)."""
+    moments at least force × ``length_scale``); returns the largest ratio (0 for no case)."""
+    largest = 0.0
     for k in range(normal.shape[1]):
         residual = np.zeros(6)
         magnitude = np.zeros(6)
@@ -127,6 +127,20 @@ def equilibrium(normal_map, friction_map, normal, friction, wrenches, scale, gra
         sizes[0, k], sizes[1, k] = force, moment
         ratios[0, k] = max(residual[0], residual[1], residual[2]) / force
         ratios[1, k] = max(residual[3], residual[4], residual[5]) / moment
+        for ratio in (ratios[0, k], ratios[1, k]):
+            if not ratio <= largest:  # (NaN propagates)
+                largest = ratio
+    return largest
+
+
+def largest_magnitude(values):  # pragma: no cover - compiled
+    """The largest absolute value of ``values`` ``(C, K)`` (0 for none; NaN if any is)."""
+    largest = 0.0
+    for c in range(values.shape[0]):
+        for k in range(values.shape[1]):
+            if not abs(values[c, k]) <= largest:  # (NaN propagates)
+                largest = abs(values[c, k])
+    return largest
 
 
 def troubled(normal, use, noise):  # pragma: no cover - compiled
@@ -147,3 +161,5 @@ def troubled(normal, use, noise):  # pragma: no cover - compiled
 
 _EQUILIBRIUM = compiled_scalar(equilibrium)
 _TROUBLED = compiled_scalar(troubled)
+#: :func:`largest_magnitude` compiled (also for the analysis).
+LARGEST_MAGNITUDE = compiled_scalar(largest_magnitude)

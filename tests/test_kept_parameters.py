@@ -1,0 +1,144 @@
+"""Re-solves through the kept parameter vector of the last direct solve (``Runner._again``)
+against solves whose parameters go through cvxpy, as on a first solve."""
+
+import cvxpy as cp
+import numpy as np
+import pytest
+
+from fixplan import pressure
+from fixplan.planner.direct_solve import DirectSolver
+from fixplan.planner.planner import Planner
+from fixplan.planner.problem import Body, Contact, Load, Problem
+from fixplan.planner.runner import Runner
+
+
+def fixture(model, load):
+    """A block on three pads against two locators, held by a top and a side clamp."""
+    pad, jaw = pressure.disk(0.01), pressure.rectangle(0.02, 0.01)
+    places = [
+        ("pad-1", "support", [0.04, 0.0, 0.0], [0, 0, 1], pad),
+        ("pad-2", "support", [-0.04, 0.03, 0.0], [0, 0, 1], pad),
+        ("pad-3", "support", [-0.04, -0.03, 0.0], [0, 0, 1], pad),
+        ("side", "locator", [0.0, -0.04, 0.02], [0, 1, 0], jaw),
+        ("end", "locator", [-0.06, 0.0, 0.02], [1, 0, 0], jaw),
+        ("clamp-top", "clamp", [0.0, 0.0, 0.04], [0, 0, -1], pad),
+        ("clamp-side", "clamp", [0.0, 0.04, 0.02], [0, -1, 0], jaw),
+    ]
+    contacts = [
+        Contact(name=n, role=r, position=x, normal=v, mu=0.4, model=model, patch=patch)
+        for n, r, x, v, patch in places
+    ]
+    body = Body(mass=2.0, center_of_mass=[0.0, 0.0, 0.02])
+    return Problem(body=body, contacts=contacts, loads=load, objective="min-total-clamp-force")
+
+
+#: Optima of the same program from two warm starts (simplex) or two interior-point runs
+#: stopped at gap 1e-9 (Clarabel), relative to the largest force or multiple.
+RTOL = {"pyramid": 1e-9, "ellipsoid": 1e-6}
+
+
+def path(count, *, scales=(1.0,)):
+    """Loads of a turning cut, each scaled in turn by one of ``scales`` (new force units)."""
+    angles = np.linspace(0.0, 2.0 * np.pi, count)
+    return [
+        [
+            Load(
+                name="cut",
+                force=[80.0 * s * np.cos(a), 80.0 * s * np.sin(a), -30.0 * s],
+                point=[0.02 * np.cos(a / 2), 0.01, 0.04],
+                torque=[0.0, 0.0, 0.8 * s * np.sin(a)],
+            )
+        ]
+        for a, s in zip(angles, np.resize(scales, count), strict=True)
+    ]
+
+
+def comparable(plan):
+    """What a plan states that does not depend on which optimum the solver returned."""
+    held = plan.held_intervals.get("cut", (np.nan, np.nan))
+    return np.array([plan.objective_value, plan.safety_factor or np.nan, *held])
+
+
+def assert_same(plan, reference, rtol):
+    assert plan.status == reference.status == "optimal"
+    assert plan.held == reference.held
+    np.testing.assert_allclose(comparable(plan), comparable(reference), rtol=rtol, atol=rtol)
+
+
+def through_cvxpy(planner):
+    """``planner`` with its parameters set through cvxpy on every solve (no kept vector)."""
+    planner._runner._again = lambda *args: (False, None)
+    return planner
+
+
+@pytest.fixture
+def kept_solves(monkeypatch):
+    """Counts the solves that went through the kept vector."""
+    counts = {"kept": 0}
+    again = Runner._again
+
+    def counted(self, *args):
+        tried, result = again(self, *args)
+        counts["kept"] += result is not None
+        return tried, result
+
+    monkeypatch.setattr(Runner, "_again", counted)
+    return counts
+
+
+@pytest.mark.parametrize("model", ["pyramid", "ellipsoid"])
+def test_re_solves_with_their_analysis_match_solves_set_through_cvxpy(model, kept_solves):
+    loads = path(24, scales=(1.0, 1.0, 1.0, 40.0, 0.02))  # force units change now and then
+    planner = Planner(fixture(model, loads[0]))
+    reference = through_cvxpy(Planner(fixture(model, loads[0])))
+    for load in loads[:3]:
+        planner.solve(load)
+        reference.solve(load)
+    kept_solves["kept"] = 0
+    for load in loads[3:]:
+        plan = planner.solve(load)
+        assert_same(plan, reference.solve(load), RTOL[model])
+    # Of the force solve and the two fixed-force solves of each analysis, those whose force
+    # unit did not change (37 of 63 here).
+    assert kept_solves["kept"] >= len(loads[3:])
+
+
+def test_disabled_contacts_are_part_of_the_kept_state(kept_solves):
+    loads = path(12)
+    planner = Planner(fixture("pyramid", loads[0]), switchable=True)
+    reference = through_cvxpy(Planner(fixture("pyramid", loads[0]), switchable=True))
+    choices = [(), ("clamp-side",), ("end",), ()]
+    for k, load in enumerate(loads):
+        disabled = choices[k % len(choices)]
+        plan = planner.solve(load, disabled=disabled)
+        assert_same(plan, reference.solve(load, disabled=disabled), RTOL["pyramid"])
+        if "clamp-side" in disabled:  # (zero up to the solver's noise)
+            assert abs(plan.forces["clamp-side"]) <= 1e-9 * plan.objective_value
+    assert kept_solves["kept"] > 0
+
+
+def test_written_parameters_give_the_vector_of_set_parameters():
+    x = cp.Variable(3)
+    task, given = cp.Parameter((2, 2)), cp.Parameter(2, nonneg=True)
+    unused = cp.Parameter(4)
+    problem = cp.Problem(
+        cp.Minimize(cp.sum(x)),
+        [x[:2] >= task[:, 0] + task[:, 1], x[2] >= given[0] - given[1], x >= -5],
+    )
+    task.value, given.value = np.ones((2, 2)), np.ones(2)
+    problem.solve(solver=cp.CLARABEL)
+    problem.solve(solver=cp.CLARABEL)
+    direct = DirectSolver.create(problem, {})
+    assert direct is not None
+    vector = direct.parameter_vector()
+    new_task, new_given = np.array([[1.0, 2.0], [3.0, 4.0]]), np.array([5.0, 1.5])
+    direct.write(vector, task, new_task)
+    direct.write(vector, given, new_given)
+    direct.write(vector, unused, np.arange(4.0))  # not in the program: left out
+    task.value, given.value = new_task, new_given
+    np.testing.assert_array_equal(vector, direct.parameter_vector())
+    # A linear program: solved by the simplex, whose objective value is taken when asked.
+    direct.solve(vector=vector)
+    assert direct.method == "dual simplex"
+    # x >= (1 + 2, 3 + 4, 5 - 1.5): the sum is 13.5.
+    assert direct.objective_value == pytest.approx(13.5, rel=1e-14)
