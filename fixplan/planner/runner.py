@@ -230,9 +230,8 @@ class Runner:
         self, objective, wrenches, given, order, numbers, sense, disabled, progress
     ) -> list[tuple[dict, int]]:
         """The results of the cases of a linear fixed-force objective whose given forces are
-        plain numbers, one by one in ``order``, each through :meth:`_again` where it applies
-        (after the first case, the given forces are written once per force unit and then only
-        the task wrench per case), else through :meth:`_run_block`."""
+        plain numbers, one by one in ``order``: each through :meth:`_again` where it applies
+        (only its task wrench written), else through :meth:`_run_block`."""
         results = []
         for position, j in enumerate(order):
             wrench = wrenches[:, j : j + 1]
@@ -252,11 +251,12 @@ class Runner:
         """A block straight through the direct solver of ``objective``, its parameters written
         into the parameter vector of its last direct solve (:class:`_Kept`) rather than set
         through cvxpy: the task wrenches, and the given forces (also set, see ``put``) and
-        ``sense`` where they changed.
-        Applies where that solve was in the same force unit, with the same contacts disabled
-        and none ``unloaded``. Returns ``(tried, result)``: whether the direct solver was
-        tried, and the result in newtons (``None`` where it did not apply or failed: the caller
-        then takes the full path, :meth:`_solve_block`)."""
+        ``sense`` where they changed. Applies where that solve was in the same force unit, with
+        the same contacts disabled and none ``unloaded``.
+
+        Returns ``(tried, result)``: whether the direct solver was tried, and the result in
+        newtons (``None`` where it did not apply or failed: the caller then takes the full
+        path, :meth:`_solve_block`)."""
         key = (objective, False)
         kept = self._kept.get(key)
         if kept is None or unloaded is not None or kept.disabled != _bytes(disabled):
