@@ -403,9 +403,9 @@ class Runner:
             if not (accurate or exact or tried):
                 direct = self._direct.get(key)
                 vector = None if direct is None else direct.parameter_vector()
-                result = None if direct is None else self._direct_result(key, stacked, vector)
+                result = None if vector is None else self._direct_result(key, stacked, vector)
                 if result is not None:
-                    if unloaded is None and not osculating:
+                    if unloaded is None:  # (osculating programs are never solved directly)
                         self._kept[key] = _Kept(unit, _bytes(disabled), _given_state(given),
                                                 float(sense), vector)  # fmt: skip
                     return _in_newtons(result, unit, objective)

@@ -78,11 +78,17 @@ class ClosedFormKernel(SupportKernel):
     """A kernel summed in closed form over a table (``_table``, of the kind ``_KIND``, read by
     :func:`near_terms`) for centres of rotation within
     :data:`~fixplan.tolerances.FAR_FIELD_RADII` sizes, and by the Gauss rule ``far`` of the same
-    field beyond (and for pure translations), where the closed-form terms cancel. Subclasses set
-    ``_table`` and ``_size`` (the far rule's, computed once) on construction, and the cost
-    ``_TERM_WORK`` of one of their terms in points summed."""
+    field beyond (and for pure translations), where the closed-form terms cancel. Subclasses
+    declare the fields ``_table`` and ``_size`` (set by :meth:`_store` on construction), the
+    cost ``_TERM_WORK`` of one of their terms in points summed, and ``far``."""
 
     __slots__ = ()
+
+    def _store(self, columns) -> None:
+        """Keep the table of ``columns`` (arrays ``(n,)`` or ``(n, k)``, one row per term) and
+        the far rule's size, computed once."""
+        object.__setattr__(self, "_table", np.ascontiguousarray(np.column_stack(columns).T))
+        object.__setattr__(self, "_size", self.far.size)
 
     @property
     def size(self) -> float:
@@ -159,9 +165,9 @@ class EdgeSumKernel(ClosedFormKernel):
         ends = np.asarray(self.ends, dtype=float)
         direction = ends - starts
         length = np.hypot(direction[:, 0], direction[:, 1])
-        columns = (starts, ends, direction / length[:, None], np.asarray(self.weights, dtype=float))
-        object.__setattr__(self, "_table", np.ascontiguousarray(np.column_stack(columns).T))
-        object.__setattr__(self, "_size", self.far.size)
+        self._store(
+            (starts, ends, direction / length[:, None], np.asarray(self.weights, dtype=float))
+        )
 
 
 @dataclass(frozen=True, slots=True)
@@ -184,6 +190,4 @@ class GridKernel(ClosedFormKernel):
     _TERM_WORK = 4  # 27-39 ns per node against 8.6 ns per point, Hessians included
 
     def __post_init__(self):
-        columns = (np.asarray(self.nodes, dtype=float), np.asarray(self.kappa, dtype=float))
-        object.__setattr__(self, "_table", np.ascontiguousarray(np.column_stack(columns).T))
-        object.__setattr__(self, "_size", self.far.size)
+        self._store((np.asarray(self.nodes, dtype=float), np.asarray(self.kappa, dtype=float)))
