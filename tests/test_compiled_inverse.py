@@ -142,6 +142,41 @@ def test_a_start_twist_moves_where_newton_starts_not_the_answer(name):
         assert np.max(angles(surface, twists, expected_twists)) <= MOTION_RAD, what
 
 
+#: The Hessians Newton hands over: computed at the answer, or (a full step in the quadratic
+#: region ended the iteration) at the iterate before, a relative step of about 1e-6 away.
+HANDED_OVER_RTOL = 2e-5
+
+
+@pytest.mark.parametrize("name", sorted(SURFACES))
+def test_newton_hands_over_the_hessians_at_its_answers(name):
+    # The planner's osculating ellipsoids take the support's curvature at each answer from the
+    # inverse map instead of evaluating it again; facets and kinks (no Hessian from Newton)
+    # are evaluated at their twists.
+    surface = SURFACES[name]()
+    rng = np.random.default_rng(9)
+    found = distributions(surface, rng)
+    loads = np.concatenate(list(found.values()))
+    units = np.array([surface.max_force, surface.max_force, surface.max_moment])
+    handed = np.empty((len(loads), 3, 3))
+    safety, twists = surface._compiled.solve(loads, units, surface._scale, None, handed)
+    expected_safety, expected_twists = surface._compiled.solve(loads, units, surface._scale)
+    np.testing.assert_array_equal(safety, expected_safety)
+    np.testing.assert_array_equal(twists, expected_twists)
+    # Newton's own answers carry their Hessians (point supports: those off the kinks).
+    from_twists = np.isnan(handed[: len(found["from twists"]), 0, 0])
+    assert not from_twists.all() if surface.has_facets else not from_twists.any()
+    if "on facets" in found:
+        assert np.isnan(handed[-len(found["on facets"]) :]).all()
+    reference = surface._trusted_hessians(twists)
+    safety, twists, hessians = surface._trusted_inverse_and_hessians(loads)
+    np.testing.assert_array_equal(twists, expected_twists)
+    size = np.abs(reference).max(axis=(1, 2))
+    gap = np.abs(hessians - reference).max(axis=(1, 2)) / size
+    assert gap.max() <= HANDED_OVER_RTOL
+    missing = np.isnan(handed[:, 0, 0])
+    np.testing.assert_array_equal(hessians[missing], reference[missing])
+
+
 @pytest.mark.parametrize("name", sorted(SURFACES))
 def test_small_batches_of_the_support_function_give_the_numpy_kernels_values(name):
     # Up to COMPILED_SUPPORT_MAX_TWISTS twists the compiled kernel answers, one at a time.

@@ -144,6 +144,18 @@ class Exact(FrictionModel):
         support = safety * np.einsum("ij,ij->i", loads, twists)
         return twists / support[:, None], 1.0 / safety - 1.0
 
+    def _cut_and_curvature(
+        self, loads: np.ndarray, start: np.ndarray | None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`cut`, and the Hessians ``(K, 3, 3)`` of ``h_1`` at the planes ``a`` (the
+        twists ``V`` over ``h_1(V)``): ``∇²h_1(a) = h_1(V) ∇²h_1(V)``, ``h_1`` being
+        homogeneous of degree 1, from the Hessians the inverse map found at ``V``."""
+        found = self.surface._trusted_inverse_and_hessians(loads * self.surface.normal_force, start)
+        safety, twists, hessians = found
+        support = safety * np.einsum("ij,ij->i", loads, twists)
+        curvature = hessians * (support / self.surface.normal_force)[:, None, None]
+        return twists / support[:, None], 1.0 / safety - 1.0, curvature
+
     def osculating(
         self, loads: np.ndarray, start: np.ndarray | None = None
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -177,11 +189,10 @@ class Exact(FrictionModel):
         the same value, gradient and Hessian at ``u``. The algebra runs in normalised
         coordinates (loads over :meth:`_units`), where ``J`` is well conditioned.
         """
-        planes, excess = self.cut(loads, start)
+        planes, excess, curvature = self._cut_and_curvature(loads, start)
         units = self._units()
         points = loads / (1.0 + excess)[:, None]
         a, u = planes * units, points / units  # normalised plane and point, a · u = 1
-        curvature = self.surface._trusted_hessians(planes) / self.surface.normal_force
         curvature /= units[None, :, None] * units[None, None, :]
         factors = np.empty((len(loads), 3, 3))
         _OSCULATING_FACTORS(a, u, curvature, factors)

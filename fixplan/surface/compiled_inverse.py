@@ -176,14 +176,15 @@ def _newton_step(g1, g2, h11, h12, h22):  # pragma: no cover - compiled
     return -g1, -g2, g1 * g1 + g2 * g2
 
 
-def _newton(kernel, eps2, twist, b1, b2, kinks):  # pragma: no cover - compiled
+def _newton(kernel, eps2, twist, b1, b2, kinks, current):  # pragma: no cover - compiled
     """Damped Newton on the plane through ``twist`` spanned by ``b1``, ``b2`` [SI], in place on
     ``twist``. Returns whether it stalled (no descent, a crawl into a kink unless ``kinks`` is
     :data:`SMOOTH`, or the iteration limit), the support value at the final ``twist`` and,
     with ``kinks`` :data:`PROBES`, the support point whose kink the first rejected full step
-    crosses (Newton stops there; else -1)."""
+    crosses (Newton stops there; else -1). ``current`` (10,) is left with the terms at the
+    final ``twist``: its Hessian is that of the last iterate where a full step in the quadratic
+    region ended the iteration (a relative change of the size of that step, about 1e-6)."""
     local = np.empty(10)
-    current = np.empty(10)
     new = np.empty(10)
     step = np.empty(3)
     trial = np.empty(3)
@@ -204,6 +205,7 @@ def _newton(kernel, eps2, twist, b1, b2, kinks):  # pragma: no cover - compiled
             new[4:] = current[4:]
             if _newton_step(*_projected(new, b1, b2))[2] <= INVERSE_RTOL**2 * new[0]:
                 twist[:] = trial
+                current[:] = new
                 return False, new[0], -1
         # The full step is tried with the terms of the next iteration: it is nearly always taken.
         _terms(kernel, eps2, trial, True, local, new)
@@ -367,7 +369,7 @@ def _escape_kink(kernel, twist, b1, b2, k, facet, rest):  # pragma: no cover - c
     if not (curvature > 0.0 and math.isfinite(curvature)):
         return 0.0
     start = facet + ((pull - pw[k]) / curvature) * d
-    stalled, h, _ = _newton(kernel, 0.0, start, b1, b2, CRAWLS)
+    stalled, h, _ = _newton(kernel, 0.0, start, b1, b2, CRAWLS, np.empty(10))
     if stalled:
         return 0.0
     twist[:] = start
@@ -380,9 +382,10 @@ def _continuation(kernel, units, scale, twist, safety, b1, b2):  # pragma: no co
     the last ended. Keeps the result (``twist`` in place) only where it lowers ``h``; returns
     the safety factor."""
     start = twist.copy()
+    terms = np.empty(10)
     for eta in SMOOTHING_STAGES:
-        _newton(kernel, (eta / units[0]) ** 2, twist, b1, b2, SMOOTH)
-    found = scale * _newton(kernel, 0.0, twist, b1, b2, SMOOTH)[1]
+        _newton(kernel, (eta / units[0]) ** 2, twist, b1, b2, SMOOTH, terms)
+    found = scale * _newton(kernel, 0.0, twist, b1, b2, SMOOTH, terms)[1]
     if found < safety:
         return found
     twist[:] = start
@@ -449,21 +452,25 @@ def _start_on_plane(units, start, twist, b1, b2):  # pragma: no cover - compiled
         twist[i] += alpha * b1[i] + beta * b2[i]
 
 
-def _solve_load(kernel, discrete, load, units, scale, twist, start):  # pragma: no cover
+def _solve_load(kernel, discrete, load, units, scale, twist, start, final):  # pragma: no cover
     """Safety factor of one nonzero ``load`` (its sliding twist [SI] in ``twist``) and, where
     Newton stopped away from a minimum, its projected gradient relative to ``h`` (else 0).
     Newton starts where the ray of ``start`` meets the plane ``L·V = 1``
-    (:func:`_start_on_plane`), else from the ellipsoid's twist."""
+    (:func:`_start_on_plane`), else from the ellipsoid's twist. ``final`` (10,) is left with
+    the terms of :func:`_newton` at ``twist`` where its iteration found the answer, else NaN
+    (facets, kinks, smoothing)."""
     b1 = np.empty(3)
     b2 = np.empty(3)
     _plane(load, units, twist, b1, b2)
     _start_on_plane(units, start, twist, b1, b2)
-    stalled, h, kink = _newton(kernel, 0.0, twist, b1, b2, PROBES if discrete else SMOOTH)
+    kinks = PROBES if discrete else SMOOTH
+    stalled, h, kink = _newton(kernel, 0.0, twist, b1, b2, kinks, final)
     if kink >= 0:
+        final[0] = np.nan
         certified = _certify_kink(kernel, load, scale, twist, b1, b2, kink)
         if certified > 0.0:
             return certified, 0.0
-        stalled, h, _ = _newton(kernel, 0.0, twist, b1, b2, CRAWLS)
+        stalled, h, _ = _newton(kernel, 0.0, twist, b1, b2, CRAWLS, final)
     safety = scale * h
     on_facet = False
     if discrete:
@@ -472,6 +479,8 @@ def _solve_load(kernel, discrete, load, units, scale, twist, start):  # pragma: 
         _slowest(kernel, twist, index, speed)
         if stalled or speed[0] <= NEAR_KINK * h:
             safety, on_facet = _facets(kernel, load, scale, twist, safety)
+        if stalled or on_facet:
+            final[0] = np.nan
         if stalled and not on_facet:
             certified = _certify_kink(kernel, load, scale, twist, b1, b2, index[0])
             if certified > 0.0:
@@ -489,44 +498,66 @@ def _solve_load(kernel, discrete, load, units, scale, twist, start):  # pragma: 
 
 
 def _solve_row(
-    kernel, discrete, loads, units, scale, k, start, out_safety, out_twist, out_gradient
+    kernel,
+    discrete,
+    loads,
+    units,
+    scale,
+    k,
+    start,
+    out_safety,
+    out_twist,
+    out_gradient,
+    out_hessian,
 ):  # pragma: no cover - compiled
     """Row ``k`` of :func:`_solve`: the answer of ``loads[k]``, Newton started from ``start``."""
     # Solve for a load of unit size (normalised): s(c L) = s(L) / c.
     size = 0.0
     for i in range(3):
         size = max(size, abs(loads[k, i] / units[i]))
+    final = np.empty(10)
+    final[0] = np.nan
     if size == 0.0:
         out_safety[k] = np.inf
         out_twist[k, :] = np.nan
         out_gradient[k] = 0.0
+    else:
+        safety, out_gradient[k] = _solve_load(
+            kernel, discrete, loads[k] / size, units, scale, out_twist[k], start, final
+        )
+        out_safety[k] = safety / size
+    if out_hessian.shape[0] == 0:
         return
-    safety, out_gradient[k] = _solve_load(
-        kernel, discrete, loads[k] / size, units, scale, out_twist[k], start
-    )
-    out_safety[k] = safety / size
+    if math.isnan(final[0]):
+        out_hessian[k, :, :] = np.nan
+    else:
+        _unpack(final, out_hessian[k])
 
 
 def _solve(
-    kernel, discrete, loads, units, scale, out_safety, out_twist, out_gradient
+    kernel, discrete, loads, units, scale, out_safety, out_twist, out_gradient, out_hessian
 ):  # pragma: no cover - compiled
-    """Safety factors, twists and (where Newton stalled) relative gradients of ``loads``."""
+    """Safety factors, twists, (where Newton stalled) relative gradients of ``loads`` and, if
+    ``out_hessian`` has their rows, the Hessians that Newton found at the twists (NaN where
+    none)."""
     start = np.zeros(3)  # none (read only): Newton starts from the ellipsoid's twist
     for k in numba.prange(loads.shape[0]):
         _solve_row(
-            kernel, discrete, loads, units, scale, k, start, out_safety, out_twist, out_gradient
-        )
+            kernel, discrete, loads, units, scale, k, start, out_safety, out_twist, out_gradient,
+            out_hessian,
+        )  # fmt: skip
 
 
 def _solve_from(
-    kernel, discrete, loads, units, scale, starts, out_safety, out_twist, out_gradient
+    kernel, discrete, loads, units, scale, starts, out_safety, out_twist, out_gradient, out_hessian
 ):  # pragma: no cover - compiled
     """:func:`_solve` with Newton started from ``starts`` (a separate loop: the extra argument
     costs a single query about a microsecond)."""
     for k in numba.prange(loads.shape[0]):
         _solve_row(
-            kernel, discrete, loads, units, scale, k, starts[k], out_safety, out_twist, out_gradient
-        )
+            kernel, discrete, loads, units, scale, k, starts[k], out_safety, out_twist,
+            out_gradient, out_hessian,
+        )  # fmt: skip
 
 
 def _supports(kernel, twists, out):  # pragma: no cover - compiled
@@ -572,6 +603,9 @@ _SOLVE = _compiled(_solve)
 _SOLVE_FROM = _compiled(_solve_from)
 _HESSIANS = _compiled(_hessians)
 
+#: The ``out_hessian`` of :func:`_solve` where no Hessians are asked for.
+_NO_HESSIANS = np.empty((0, 3, 3))
+
 
 @dataclass(frozen=True, slots=True)
 class CompiledKernel:
@@ -591,6 +625,7 @@ class CompiledKernel:
         units: np.ndarray,
         scale: float,
         start: np.ndarray | None = None,
+        out_hessians: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Safety factors ``(K,)`` and sliding twists ``(K, 3)`` [SI] of ``loads`` ``(K, 3)``
         [N, N m] (``inf`` and NaN for a zero load); ``units`` = ``(max_force, max_force,
@@ -599,6 +634,11 @@ class CompiledKernel:
         more than :data:`START_MAX_ANGLE` from their load's ray (or not finite) start from the
         ellipsoid's twist, as all do without it.
 
+        ``out_hessians`` ``(K, 3, 3)``, where given, receives the Hessians of the unit-friction
+        support at the twists that Newton computed on its way (see :func:`_newton`; relative
+        difference up to about 1e-6 from :meth:`hessians` there), NaN where the answer came
+        otherwise (facets, kinks).
+
         Raises :class:`ConvergenceError` where Newton stopped away from a minimum.
         """
         count = len(loads)
@@ -606,9 +646,10 @@ class CompiledKernel:
         twist = np.empty((count, 3))
         gradient = np.empty(count)
         loads = np.ascontiguousarray(loads, dtype=float)
+        hessians = _NO_HESSIANS if out_hessians is None else out_hessians
         if start is None:
             _pick(_SOLVE, count, self.work)(
-                self.parts, self.discrete, loads, units, scale, safety, twist, gradient
+                self.parts, self.discrete, loads, units, scale, safety, twist, gradient, hessians
             )
         else:
             starts = np.array(start, dtype=float)
@@ -617,8 +658,9 @@ class CompiledKernel:
                     f"start must have the shape of the loads {(count, 3)}, got {starts.shape}"
                 )
             _pick(_SOLVE_FROM, count, self.work)(
-                self.parts, self.discrete, loads, units, scale, starts, safety, twist, gradient
-            )
+                self.parts, self.discrete, loads, units, scale, starts, safety, twist, gradient,
+                hessians,
+            )  # fmt: skip
         worst = int(np.argmax(gradient)) if count > 1 else 0
         if gradient[worst] > INVERSE_GRADIENT_RTOL:
             raise not_converged(loads[worst], float(gradient[worst]))

@@ -311,6 +311,22 @@ class LimitSurface:
         safety, twists, _ = self._inverse(loads)
         return safety, twists
 
+    def _trusted_inverse_and_hessians(
+        self, loads: np.ndarray, start: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`_trusted_inverse` and the support Hessians ``(K, 3, 3)`` at the twists found:
+        for compiled kernels those Newton computed there (one evaluation fewer per load),
+        else (facets, kinks, other kernels) :meth:`_trusted_hessians`."""
+        if self._compiled is None or self._shape is not None:
+            safety, twists = self._trusted_inverse(loads, start)
+            return safety, twists, self._trusted_hessians(twists)
+        hessians = np.empty((len(loads), 3, 3))
+        safety, twists = self._compiled.solve(loads, self._units, self._scale, start, hessians)
+        missing = np.flatnonzero(np.isnan(hessians[:, 0, 0]))
+        if missing.size:
+            hessians[missing] = self._compiled.hessians(twists[missing])
+        return safety, twists, self._scale * hessians
+
     def _trusted_hessians(self, twists: np.ndarray) -> np.ndarray:
         """:meth:`support_hessian` ``(K, 3, 3)`` of nonzero finite twists ``(K, 3)`` from a
         caller that checked them (see :meth:`_trusted_inverse`)."""
