@@ -5,7 +5,7 @@ problems, each model timed in a fresh process (peak resident memory of that proc
 
 - a pinch: two fingers with ``cells × cells`` tactile grids (a Hertz-like pressure map over
   20 x 20 mm), holding a weight and a torque about the grasp axis, 4 load cases; build + first
-  solve and the median of 5 re-solves with new loads;
+  solve and the median of ``RESOLVES`` re-solves with new loads;
 - the fixture of ``bench_planner.py`` (8 area contacts x 20 milling loads), the same figures
   and the number of rounds of the exact model (osculating ellipsoids, or cuts where those do
   not settle), with the time per round of a re-solve spent in Clarabel and in moving the
@@ -32,6 +32,9 @@ from fixplan.planner.planner import Planner
 sys.path.insert(0, str(Path(__file__).parent))
 from bench_planner import fixture, milling_loads
 from performance_rows import emit
+
+#: Re-solves with new loads per problem and model (their median is reported).
+RESOLVES = 20
 
 
 def tactile_pinch(model: str, cells: int, loads: list[Load]) -> Problem:
@@ -93,7 +96,7 @@ def measure(case: str, model: str, cells: int) -> dict:
     assert plan.status == "optimal", plan.status
     first_rounds, times = len(rounds), []
     spent.update(cuts=0.0, solver=0.0)
-    for seed in range(1, 6):
+    for seed in range(1, RESOLVES + 1):
         loads = new_loads(seed)
         start = time.perf_counter()
         again = planner.solve(loads, analyse=False)
@@ -103,7 +106,7 @@ def measure(case: str, model: str, cells: int) -> dict:
         "first": first,
         "resolve": float(np.median(times)),
         "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
-        "rounds": (first_rounds, (len(rounds) - first_rounds) / 5),
+        "rounds": (first_rounds, (len(rounds) - first_rounds) / RESOLVES),
         "per_round": {
             key: value / max(len(rounds) - first_rounds, 1) for key, value in spent.items()
         },
