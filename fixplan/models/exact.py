@@ -140,21 +140,26 @@ class Exact(FrictionModel):
         support is read from the inverse map's answer instead of being integrated again
         (relative difference about 1e-14, far below the planner's ``CUT_MARGIN``).
         """
-        safety, twists = self.surface._trusted_inverse(loads * self.surface.normal_force, start)
-        support = safety * np.einsum("ij,ij->i", loads, twists)
-        return twists / support[:, None], 1.0 / safety - 1.0
+        planes, excess, _ = self._cuts(loads, start, curvature=False)
+        return planes, excess
 
-    def _cut_and_curvature(
-        self, loads: np.ndarray, start: np.ndarray | None
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """:meth:`cut`, and the Hessians ``(K, 3, 3)`` of ``h_1`` at the planes ``a`` (the
-        twists ``V`` over ``h_1(V)``): ``∇²h_1(a) = h_1(V) ∇²h_1(V)``, ``h_1`` being
-        homogeneous of degree 1, from the Hessians the inverse map found at ``V``."""
-        found = self.surface._trusted_inverse_and_hessians(loads * self.surface.normal_force, start)
-        safety, twists, hessians = found
+    def _cuts(
+        self, loads: np.ndarray, start: np.ndarray | None, *, curvature: bool
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """:meth:`cut`, and with ``curvature`` the Hessians ``(K, 3, 3)`` of ``h_1`` at the
+        planes ``a`` (the twists ``V`` over ``h_1(V)``; else ``None``): ``∇²h_1(a) =
+        h_1(V) ∇²h_1(V)``, ``h_1`` being homogeneous of degree 1, from the Hessians the inverse
+        map found at ``V``."""
+        scaled = loads * self.surface.normal_force
+        hessians = None
+        if curvature:
+            safety, twists, hessians = self.surface._trusted_inverse_and_hessians(scaled, start)
+        else:
+            safety, twists = self.surface._trusted_inverse(scaled, start)
         support = safety * np.einsum("ij,ij->i", loads, twists)
-        curvature = hessians * (support / self.surface.normal_force)[:, None, None]
-        return twists / support[:, None], 1.0 / safety - 1.0, curvature
+        if hessians is not None:
+            hessians = hessians * (support / self.surface.normal_force)[:, None, None]
+        return twists / support[:, None], 1.0 / safety - 1.0, hessians
 
     def osculating(
         self, loads: np.ndarray, start: np.ndarray | None = None
@@ -189,7 +194,7 @@ class Exact(FrictionModel):
         the same value, gradient and Hessian at ``u``. The algebra runs in normalised
         coordinates (loads over :meth:`_units`), where ``J`` is well conditioned.
         """
-        planes, excess, curvature = self._cut_and_curvature(loads, start)
+        planes, excess, curvature = self._cuts(loads, start, curvature=True)
         units = self._units()
         points = loads / (1.0 + excess)[:, None]
         a, u = planes * units, points / units  # normalised plane and point, a · u = 1
