@@ -52,24 +52,20 @@ def analyse_cases(
     cap = MAX_SAFETY_FACTOR * (1.0 - CAP_RTOL)
     critical = _MULTIPLES(k_max, k_min, held, cap, MULTIPLE_ATOL, HELD_RTOL)
     normal, friction, dual = highest["normal"], highest["friction"], highest.get("dual")
+    high, low = k_max.tolist(), k_min.tolist()
     motions = dict.fromkeys(names)
     if dual is not None:
-        moving = np.flatnonzero(np.isfinite(k_max) & dual.any(axis=0))
-        twists = staying(dual[:, moving], normal[:, moving])
-        # Towards the task load: the dual's sign is the solver's choice.
-        twists *= np.where((wrenches[:, moving] * twists).sum(axis=0) >= 0.0, 1.0, -1.0)
-        for j, twist in zip(moving, twists.T, strict=True):
-            if twist.any():
-                motions[names[j]] = Screw.from_twist(twist, length_scale)
+        twists = staying(dual, normal, wrenches)
+        for j in range(len(high)):
+            if high[j] < np.inf and twists[:, j].any():
+                motions[names[j]] = Screw.from_twist(twists[:, j], length_scale)
     noise = FRICTION_SET_RTOL * max(LARGEST_MAGNITUDE(normal), 1e-12)
     known = highest.get("known_use")
     utilisation = np.minimum(friction_use(friction, normal, noise=noise, known=known), 1.0)
     return {
-        "safety_factors": dict(zip(names, k_max.tolist(), strict=True)),
+        "safety_factors": dict(zip(names, high, strict=True)),
         "safety_factor": float(k_max.min()),
-        "held_intervals": dict(
-            zip(names, zip(k_min.tolist(), k_max.tolist(), strict=True), strict=True)
-        ),
+        "held_intervals": dict(zip(names, zip(low, high, strict=True), strict=True)),
         "held": dict(zip(names, held.tolist(), strict=True)),
         "motions": motions,
         "utilisation": utilisation,
@@ -85,7 +81,8 @@ class StayingInContact:
     projected out for the pressed decided contacts — unless that removes most of the motion
     (when they leave no sliding motion at all, one of them must lift off as it starts to slide);
     then the dual twist itself, which lifts no contact into the body, is the answer. The
-    projection of each set of pressed contacts is computed once (an SVD) and kept.
+    projection of each set of pressed contacts is computed once (an SVD) and kept; the twists
+    are projected in one compiled loop.
 
     Parameters
     ----------
@@ -100,40 +97,82 @@ class StayingInContact:
     def __init__(self, normal_map: np.ndarray, decided: np.ndarray, length_scale: float):
         self._normal_map = np.asarray(normal_map, dtype=float)
         self._decided = np.asarray(decided, dtype=bool)
+        self._words = -(-len(self._decided) // 64)  # of the bits of the pressed contacts
         self._length_scale = float(length_scale)
-        self._projections: dict[bytes, np.ndarray | None] = {}
+        #: The projections ``(P, 6, 6)`` found so far, and the index of each set of pressed
+        #: contacts (its words of bits) among them.
+        self._projections = np.eye(6)[None]  # (none pressed: the identity)
+        self._index: dict[bytes, int] = {}
 
-    def __call__(self, twists: np.ndarray, normal_forces: np.ndarray) -> np.ndarray:
-        """The twists ``(6, K)`` kept in contact, at the normal forces ``(C, K)`` [N]."""
-        size = np.abs(normal_forces).max(axis=0, initial=1e-300)
-        pressed = self._decided[:, None] & (normal_forces > FRICTION_SET_RTOL * size)
-        out = np.array(twists, dtype=float)
-        groups: dict[bytes, list[int]] = {}
-        for j, column in enumerate(pressed.T):
-            groups.setdefault(column.tobytes(), []).append(j)
-        for key, cases in groups.items():
-            projection = self._projection(key, pressed[:, cases[0]])
-            if projection is None:
-                continue
-            given = out[:, cases]
-            projected = projection @ given
-            # Kept where at least half the motion (in norm) remains: squared, a quarter.
-            kept = (projected * projected).sum(axis=0) >= 0.25 * (given * given).sum(axis=0)
-            out[:, np.asarray(cases)[kept]] = projected[:, kept]
+    def __call__(
+        self, twists: np.ndarray, normal_forces: np.ndarray, towards: np.ndarray
+    ) -> np.ndarray:
+        """The twists ``(6, K)`` kept in contact at the normal forces ``(C, K)`` [N], each signed
+        to do nonnegative power with its wrench of ``towards`` ``(6, K)`` (the dual's sign is
+        the solver's choice)."""
+        normal_forces = np.asarray(normal_forces, dtype=float)
+        words = np.empty((normal_forces.shape[1], self._words), dtype=np.uint64)
+        _PRESSED(normal_forces, self._decided, FRICTION_SET_RTOL, words)
+        group = np.array(
+            [self._group(words[j], normal_forces[:, j]) for j in range(len(words))], dtype=np.intp
+        )
+        out = np.empty(np.shape(twists))
+        _KEPT(np.asarray(twists, dtype=float), self._projections, group,
+              np.asarray(towards, dtype=float), out)  # fmt: skip
         return out
 
-    def _projection(self, key: bytes, pressed: np.ndarray) -> np.ndarray | None:
-        """The orthogonal projection ``(6, 6)`` onto the twists that move no contact of
-        ``pressed`` along its normal (``None`` for none pressed)."""
-        if key not in self._projections:
-            projection = None
+    def _group(self, words: np.ndarray, normal_forces: np.ndarray) -> int:
+        """The index of the projection of the pressed contacts (``words``, see
+        :func:`pressed_contacts`) at ``normal_forces`` ``(C,)``."""
+        key = words.tobytes()
+        found = self._index.get(key)
+        if found is None:
+            size = max(np.abs(normal_forces).max(), 1e-300)
+            pressed = self._decided & (normal_forces > FRICTION_SET_RTOL * size)
+            found = 0
             if pressed.any():
                 _, singular, basis = np.linalg.svd(self._normal_map[:, pressed].T)
                 rank = int(np.sum(singular > 1e-9 * self._length_scale))
                 free = basis[rank:]
-                projection = free.T @ free
-            self._projections[key] = projection
-        return self._projections[key]
+                found = len(self._projections)
+                self._projections = np.concatenate([self._projections, (free.T @ free)[None]])
+            self._index[key] = found
+        return found
+
+
+def pressed_contacts(normal, decided, rtol, words):  # pragma: no cover - compiled
+    """Bit ``c`` of ``words[j]`` ``(K, W)``: whether contact ``c`` is ``decided`` and pressed
+    in case ``j``, by more than ``rtol`` of the largest normal force of ``normal`` ``(C, K)``."""
+    words[:] = 0
+    for j in range(normal.shape[1]):
+        size = 1e-300
+        for c in range(normal.shape[0]):
+            size = max(size, abs(normal[c, j]))
+        for c in range(normal.shape[0]):
+            if decided[c] and normal[c, j] > rtol * size:
+                words[j, c // 64] |= np.uint64(1) << np.uint64(c % 64)
+
+
+def kept_in_contact(twists, projections, group, towards, out):  # pragma: no cover - compiled
+    """``out[:, j]``: ``projections[group[j]] @ twists[:, j]`` where that keeps at least half of
+    its norm (a quarter of its square), else the twist itself; signed towards ``towards``."""
+    for j in range(twists.shape[1]):
+        projection = projections[group[j]]
+        given, kept = 0.0, 0.0
+        for row in range(6):
+            total = 0.0
+            for column in range(6):
+                total += projection[row, column] * twists[column, j]
+            out[row, j] = total
+            given += twists[row, j] * twists[row, j]
+            kept += total * total
+        if kept < 0.25 * given:
+            out[:, j] = twists[:, j]
+        power = 0.0
+        for row in range(6):
+            power += towards[row, j] * out[row, j]
+        if power < 0.0:
+            out[:, j] = -out[:, j]
 
 
 def multiples(k_max, k_min, held, cap, atol, held_rtol):  # pragma: no cover - compiled
@@ -156,3 +195,5 @@ def multiples(k_max, k_min, held, cap, atol, held_rtol):  # pragma: no cover - c
 
 
 _MULTIPLES = compiled_scalar(multiples)
+_KEPT = compiled_scalar(kept_in_contact)
+_PRESSED = compiled_scalar(pressed_contacts)

@@ -35,6 +35,9 @@ SIMPLEX_MAX_ENTRIES = 100_000
 #: variables (one load case of an 8-contact fixture has 28-35).
 SIMPLEX_MAX_CHANGING_VARIABLES = 64
 
+#: What :meth:`DirectSolver.gather` reads at position -1.
+_ZERO = np.zeros(1)
+
 #: Clarabel's statuses of a problem without a feasible point.
 INFEASIBLE = ("PrimalInfeasible", "AlmostPrimalInfeasible")
 
@@ -70,6 +73,8 @@ class DirectSolver:
         #: Clarabel's status of the last solve.
         self.status = ""
         self._dual = np.zeros(0)
+        #: The last solution and the parameter vector it was solved with.
+        self._last = (np.zeros(0), np.zeros(0))
 
     @classmethod
     def create(cls, problem: cp.Problem, settings: dict) -> DirectSolver | None:
@@ -138,10 +143,26 @@ class DirectSolver:
         self, *, accept_inaccurate: bool = False, vector: np.ndarray | None = None
     ) -> dict | None:
         """Variable values by id after a solve with the parameters' current values (or those
-        of the parameter ``vector``, :meth:`parameter_vector`'s layout).
+        of the parameter ``vector``, :meth:`parameter_vector`'s layout); ``None`` where
+        :meth:`solved` fails."""
+        if not self.solved(accept_inaccurate=accept_inaccurate, vector=vector):
+            return None
+        return self.values()
+
+    def values(self) -> dict:
+        """The variable values of the last solve, by id."""
+        x = self._last[0]
+        return {
+            key: x[start:stop].reshape(shape, order="F")
+            for key, start, stop, shape in self._placement
+        }
+
+    def solved(self, *, accept_inaccurate: bool = False, vector: np.ndarray | None = None) -> bool:
+        """Solve with the parameters' current values (or those of the parameter ``vector``);
+        the answer is then read with :meth:`solve`'s values or :meth:`gather`.
 
         A linear program goes to the warm-started dual simplex first, and to Clarabel where the
-        simplex gives up (:mod:`fixplan.planner.dual_simplex`). ``None`` when Clarabel does not
+        simplex gives up (:mod:`fixplan.planner.dual_simplex`). ``False`` when Clarabel does not
         report the problem solved (or almost solved, with ``accept_inaccurate``); :attr:`status`
         says why (use cvxpy then: it turns infeasibility into certificates).
         """
@@ -163,13 +184,28 @@ class DirectSolver:
             self.status, self.method = str(solution.status), "CLARABEL"
             solved = self.status == "Solved"
             if not (solved or (accept_inaccurate and self.status == "AlmostSolved")):
-                return None
+                return False
             x, self._dual = np.asarray(solution.x), np.asarray(solution.z)
             self._optimum = (None, None, float(solution.obj_val) + constant)
-        return {
-            key: x[start:stop].reshape(shape, order="F")
-            for key, start, stop, shape in self._placement
-        }
+        self._last = (x, vector)
+        return True
+
+    def positions(self, piece: cp.Variable | cp.Parameter) -> np.ndarray | None:
+        """Where the entries of ``piece`` (column-major) sit in what :meth:`gather` reads: a
+        variable's in the solution, a parameter's in the parameter vector after it; ``None``
+        for a parameter the compiled program does not use."""
+        for key, start, stop, _ in self._placement:
+            if key == piece.id:
+                return np.arange(start, stop)
+        entries = self._program.entries(piece)
+        if entries is None:
+            return None
+        return self._program.variables + np.arange(entries.start, entries.stop)
+
+    def gather(self, positions: np.ndarray) -> np.ndarray:
+        """The last solve's values at ``positions`` (from :meth:`positions`; ``-1`` reads 0)."""
+        x, vector = self._last
+        return np.concatenate((x, vector, _ZERO))[positions]
 
     def _simplex_solve(self, q, a, b) -> tuple[np.ndarray, np.ndarray] | None:
         """``(x, z)`` from the dual simplex of a linear program, or ``None`` (not a linear
@@ -252,7 +288,8 @@ class _Program:
         self._columns = [(p, program.param_id_to_col[p.id], p.size) for p in parameters]
         self._entries = {p.id: slice(column, column + size) for p, column, size in self._columns}
         self._size = program.total_param_size + 1  # the last entry is the constant 1
-        self._variables = program.x.size
+        #: The size of the solution vector x.
+        self.variables = program.x.size
         # The parameter vector with every parameter 0: a map applied to it is its constant part.
         constant = np.r_[np.zeros(self._size - 1), 1.0]
         q_map = sp.csr_array(program.q)
@@ -261,7 +298,7 @@ class _Program:
         self._fixed_cost = None
         if q_map[:, : self._size - 1].nnz == 0:
             full = q_map @ constant
-            self._fixed_cost = (full[: self._variables], float(full[self._variables]))
+            self._fixed_cost = (full[: self.variables], float(full[self.variables]))
         program.reduced_A.cache()
         a_map = sp.csr_array(program.reduced_A.reduced_mat)
         indices, indptr, shape = program.reduced_A.problem_data_index
@@ -288,7 +325,7 @@ class _Program:
                 )
             )
         if program.reduced_P is None or program.reduced_P.matrix_data is None:
-            self.quadratic = sp.csc_matrix((self._variables, self._variables))
+            self.quadratic = sp.csc_matrix((self.variables, self.variables))
             self.parametric_p = False
         else:
             program.reduced_P.cache()
@@ -315,7 +352,7 @@ class _Program:
         if self._fixed_cost is not None:
             return self._fixed_cost
         full = self._q @ vector
-        return full[: self._variables], float(full[self._variables])
+        return full[: self.variables], float(full[self.variables])
 
     def constraints(self, vector) -> tuple[np.ndarray, np.ndarray]:
         """Clarabel's ``A`` as its values in the fixed pattern (:meth:`matrix`) and ``b``:

@@ -127,6 +127,7 @@ class Runner:
         self._given: dict[tuple, tuple | None] = {}  # (unit, given forces) last set, if scalars
         self._units: dict[tuple, float] = {}  # the force unit [N] each problem was last set in
         self._kept: dict[tuple, _Kept] = {}  # see _again
+        self._positions: dict[tuple, np.ndarray | None] = {}  # see _answer_positions
         # Task torques over the longest lever [m] of a contact's normal force are forces.
         lever = max(float(np.linalg.norm(layout.normal_map[3:], axis=0).max()), 1e-3)
         self._per_force = np.repeat([1.0, 1.0 / lever], 3)[:, None]  # task wrench -> forces
@@ -541,12 +542,18 @@ class Runner:
         parameters' values, or those of the parameter ``vector``; the answer read from the
         solution, not through the cvxpy variables)."""
         direct = self._direct.get(key)
-        values = None if direct is None else direct.solve(vector=vector)
-        if values is None:
+        if direct is None or not direct.solved(vector=vector):
             return None
+        if key not in self._positions:
+            self._positions[key] = _answer_positions(stacked, direct)
+        positions = self._positions[key]
+        if positions is None:
+            answer = _values(stacked, direct.values())
+        else:
+            answer = _answer(stacked, direct.gather(positions))
         solver = f"{direct.method} (direct)"
-        return {"status": "optimal", "solver": solver, "warnings": [],
-                **_values(stacked, values), "dual": direct.dual(stacked.balance)}  # fmt: skip
+        return {"status": "optimal", "solver": solver, "warnings": [], **answer,
+                "dual": direct.dual(stacked.balance)}  # fmt: skip
 
     def _prepare_direct(self, key: tuple, stacked: Stacked) -> None:
         """Build the direct solver of an objective after its second cvxpy solve.
@@ -668,6 +675,45 @@ def _values(stacked: Stacked, solved: dict | None = None) -> dict:
         "normal": normal_forces(stacked, solved),
         "friction": np.asarray(friction, dtype=float),
         "scale": np.ravel(scale).astype(float),
+    }
+
+
+def _answer_positions(stacked: Stacked, direct: DirectSolver) -> np.ndarray | None:
+    """Where a direct solve's normal forces ``(C, K)``, friction loads ``(D, K)`` and (if
+    variables) multiples ``(K,)`` sit, flattened in that order, for
+    :meth:`~fixplan.planner.direct_solve.DirectSolver.gather`; ``None`` where a part is unknown
+    to the direct solver. Read so in about 3 µs, where the values by variable id take 15."""
+    cases = stacked.task.shape[1]
+    normal = np.full((len(stacked.decided), cases), -1)
+    for index, piece in stacked.normal_parts:
+        found = direct.positions(piece)
+        if found is None:
+            return None
+        normal[index] = found.reshape((len(index), -1), order="F")  # (a clamp's in every case)
+    parts = [normal, stacked.friction]
+    if isinstance(stacked.scale, cp.Variable):
+        parts.append(stacked.scale)
+    flat = [normal.ravel()]
+    for piece in parts[1:]:
+        found = direct.positions(piece)
+        if found is None:
+            return None
+        flat.append(found.reshape(piece.shape, order="F").ravel())
+    return np.concatenate(flat)
+
+
+def _answer(stacked: Stacked, values: np.ndarray) -> dict:
+    """Normal forces, friction loads and multiples from the ``values`` gathered at
+    :func:`_answer_positions`."""
+    normal_size = len(stacked.decided) * stacked.task.shape[1]
+    friction_size = normal_size + stacked.friction.size
+    scale = values[friction_size:]
+    if not isinstance(stacked.scale, cp.Variable):
+        scale = np.ravel(stacked.scale.value).astype(float)
+    return {
+        "normal": values[:normal_size].reshape(len(stacked.decided), -1),
+        "friction": values[normal_size:friction_size].reshape(stacked.friction.shape),
+        "scale": scale,
     }
 
 
