@@ -135,9 +135,10 @@ class DirectSolver:
         entries = self._program.entries(parameter)
         if entries is None:
             return
-        if np.shape(value) != parameter.shape:  # (broadcast_to costs 5-8 µs; most fit)
+        value = np.asarray(value, dtype=float)
+        if value.shape != parameter.shape:  # (broadcast_to costs 5-8 µs; most fit)
             value = np.broadcast_to(value, parameter.shape)
-        vector[entries] = np.ravel(value, order="F")
+        vector[entries] = value.ravel(order="F")
 
     def solve(
         self, *, accept_inaccurate: bool = False, vector: np.ndarray | None = None

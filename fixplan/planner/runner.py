@@ -41,6 +41,7 @@ from fixplan.planner.stacking import (
     set_given,
     set_units,
 )
+from fixplan.planner.verify import LARGEST_MAGNITUDE
 from fixplan.tolerances import CAPPED_BLOCK_RTOL, MAX_SAFETY_FACTOR
 
 SOLVERS = ("CLARABEL", "OSQP", "SCS")
@@ -127,7 +128,7 @@ class Runner:
         self._given: dict[tuple, tuple | None] = {}  # (unit, given forces) last set, if scalars
         self._units: dict[tuple, float] = {}  # the force unit [N] each problem was last set in
         self._kept: dict[tuple, _Kept] = {}  # see _again
-        self._positions: dict[tuple, np.ndarray | None] = {}  # see _answer_positions
+        self._readers: dict[tuple, _Reader | None] = {}  # of the direct solves' answers
         # Task torques over the longest lever [m] of a contact's normal force are forces.
         lever = max(float(np.linalg.norm(layout.normal_map[3:], axis=0).max()), 1e-3)
         self._per_force = np.repeat([1.0, 1.0 / lever], 3)[:, None]  # task wrench -> forces
@@ -439,9 +440,7 @@ class Runner:
     def _force_unit(self, wrenches: np.ndarray, given: dict) -> float:
         """The force unit [N] of a block with task ``wrenches`` ``(6, K)`` and ``given`` forces:
         the power of two that puts its largest force nearest ``FORCE_IN_UNITS``; 1 N for none."""
-        # (A list's max: numpy's reductions cost more on the few numbers of a control loop.)
-        largest = max((np.abs(wrenches) * self._per_force).ravel().tolist(), default=0.0)
-        largest = max(largest, self._weight)
+        largest = max(LARGEST_MAGNITUDE(wrenches * self._per_force), self._weight)
         for value in given.values():  # (plain numbers, or arrays of the cases)
             largest = max(largest, value if isinstance(value, float) else float(np.max(value)))
         return 2.0 ** round(math.log2(largest / FORCE_IN_UNITS)) if largest > 0.0 else 1.0
@@ -544,13 +543,10 @@ class Runner:
         direct = self._direct.get(key)
         if direct is None or not direct.solved(vector=vector):
             return None
-        if key not in self._positions:
-            self._positions[key] = _answer_positions(stacked, direct)
-        positions = self._positions[key]
-        if positions is None:
-            answer = _values(stacked, direct.values())
-        else:
-            answer = _answer(stacked, direct.gather(positions))
+        if key not in self._readers:
+            self._readers[key] = _Reader.of(stacked, direct)
+        reader = self._readers[key]
+        answer = _values(stacked, direct.values()) if reader is None else reader(direct)
         solver = f"{direct.method} (direct)"
         return {"status": "optimal", "solver": solver, "warnings": [], **answer,
                 "dual": direct.dual(stacked.balance)}  # fmt: skip
@@ -678,43 +674,52 @@ def _values(stacked: Stacked, solved: dict | None = None) -> dict:
     }
 
 
-def _answer_positions(stacked: Stacked, direct: DirectSolver) -> np.ndarray | None:
-    """Where a direct solve's normal forces ``(C, K)``, friction loads ``(D, K)`` and (if
-    variables) multiples ``(K,)`` sit, flattened in that order, for
-    :meth:`~fixplan.planner.direct_solve.DirectSolver.gather`; ``None`` where a part is unknown
-    to the direct solver. Read so in about 3 µs, where the values by variable id take 15."""
-    cases = stacked.task.shape[1]
-    normal = np.full((len(stacked.decided), cases), -1)
-    for index, piece in stacked.normal_parts:
-        found = direct.positions(piece)
-        if found is None:
-            return None
-        normal[index] = found.reshape((len(index), -1), order="F")  # (a clamp's in every case)
-    parts = [normal, stacked.friction]
-    if isinstance(stacked.scale, cp.Variable):
-        parts.append(stacked.scale)
-    flat = [normal.ravel()]
-    for piece in parts[1:]:
-        found = direct.positions(piece)
-        if found is None:
-            return None
-        flat.append(found.reshape(piece.shape, order="F").ravel())
-    return np.concatenate(flat)
+@dataclass(frozen=True, slots=True)
+class _Reader:
+    """Where a direct solve's answer sits, for
+    :meth:`~fixplan.planner.direct_solve.DirectSolver.gather`: the normal forces ``(C, K)``,
+    friction loads ``(D, K)`` and, where they are variables, the multiples ``(K,)``, flattened
+    in that order (``scale``: the constant multiples of a force objective instead). Read so in
+    about 3 µs, where the values by variable id take 15."""
 
+    positions: np.ndarray
+    normal_shape: tuple[int, int]
+    friction_shape: tuple[int, int]
+    scale: np.ndarray | None
 
-def _answer(stacked: Stacked, values: np.ndarray) -> dict:
-    """Normal forces, friction loads and multiples from the ``values`` gathered at
-    :func:`_answer_positions`."""
-    normal_size = len(stacked.decided) * stacked.task.shape[1]
-    friction_size = normal_size + stacked.friction.size
-    scale = values[friction_size:]
-    if not isinstance(stacked.scale, cp.Variable):
-        scale = np.ravel(stacked.scale.value).astype(float)
-    return {
-        "normal": values[:normal_size].reshape(len(stacked.decided), -1),
-        "friction": values[normal_size:friction_size].reshape(stacked.friction.shape),
-        "scale": scale,
-    }
+    @classmethod
+    def of(cls, stacked: Stacked, direct: DirectSolver) -> _Reader | None:
+        """The reader of ``stacked``'s answer; ``None`` where a part is unknown to ``direct``."""
+        normal = np.full((len(stacked.decided), stacked.task.shape[1]), -1)
+        for index, piece in stacked.normal_parts:
+            found = direct.positions(piece)
+            if found is None:
+                return None
+            normal[index] = found.reshape((len(index), -1), order="F")  # (a clamp's: every case)
+        variables = [stacked.friction]
+        constant = None
+        if isinstance(stacked.scale, cp.Variable):
+            variables.append(stacked.scale)
+        else:
+            constant = np.ravel(stacked.scale.value).astype(float)
+        flat = [normal.ravel()]
+        for variable in variables:
+            found = direct.positions(variable)
+            if found is None:
+                return None
+            flat.append(found.reshape(variable.shape, order="F").ravel())
+        return cls(np.concatenate(flat), normal.shape, stacked.friction.shape, constant)
+
+    def __call__(self, direct: DirectSolver) -> dict:
+        """Normal forces, friction loads and multiples of ``direct``'s last solve."""
+        values = direct.gather(self.positions)
+        normal_size = self.normal_shape[0] * self.normal_shape[1]
+        friction_end = normal_size + self.friction_shape[0] * self.friction_shape[1]
+        return {
+            "normal": values[:normal_size].reshape(self.normal_shape),
+            "friction": values[normal_size:friction_end].reshape(self.friction_shape),
+            "scale": values[friction_end:] if self.scale is None else self.scale.copy(),
+        }
 
 
 def _uses_dpp(problem: cp.Problem) -> bool:
