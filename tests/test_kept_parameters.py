@@ -1,6 +1,8 @@
 """Re-solves through the kept parameter vector of the last direct solve (``Runner._again``)
 against solves whose parameters go through cvxpy, as on a first solve."""
 
+import dataclasses
+
 import cvxpy as cp
 import numpy as np
 import pytest
@@ -9,7 +11,7 @@ from fixplan import pressure
 from fixplan.planner.direct_solve import DirectSolver
 from fixplan.planner.planner import Planner
 from fixplan.planner.problem import Body, Contact, Load, Problem
-from fixplan.planner.runner import Runner
+from fixplan.planner.runner import Runner, _values
 
 
 def fixture(model, load):
@@ -142,3 +144,41 @@ def test_written_parameters_give_the_vector_of_set_parameters():
     assert direct.method == "dual simplex"
     # x >= (1 + 2, 3 + 4, 5 - 1.5): the sum is 13.5.
     assert direct.objective_value == pytest.approx(13.5, rel=1e-14)
+
+
+@pytest.mark.parametrize("model", ["pyramid", "ellipsoid"])
+def test_answers_gathered_at_their_positions_are_the_variables_and_given_forces(model):
+    """The normal forces (decided and given), friction loads and multiples that a direct
+    solve's answer is read as equal those read through its variables and the Parameters."""
+    cases = [
+        [dataclasses.replace(load, name=f"cut-{j}") for j, [load] in enumerate(path(3 + k)[:3])]
+        for k in range(4)
+    ]  # three load cases, the fixed-force ones of the ellipsoid in one block of Clarabel
+    planner = Planner(fixture(model, cases[0]))
+    for loads in cases:
+        planner.solve(loads)
+    runner = planner._runner
+    read = 0
+    for key, direct in runner._direct.items():
+        reader = runner._readers.get(key)
+        if direct is None or reader is None:
+            continue
+        stacked = runner._built[key]
+        through_variables = _values(stacked, direct.values())
+        for name, value in reader(direct).items():
+            np.testing.assert_array_equal(value, through_variables[name], err_msg=name)
+        read += 1
+    assert read >= 2  # the force objective and the check (fixed forces: multiples variables)
+
+
+def test_gather_reads_variables_parameters_and_zero():
+    x = cp.Variable(2)
+    bound = cp.Parameter(2)
+    problem = cp.Problem(cp.Minimize(cp.sum(x)), [x >= bound])
+    bound.value = np.array([1.0, -2.0])
+    problem.solve(solver=cp.CLARABEL)
+    problem.solve(solver=cp.CLARABEL)
+    direct = DirectSolver.create(problem, {})
+    assert direct.solved()
+    positions = np.concatenate([direct.positions(x), direct.positions(bound), [-1]])
+    np.testing.assert_allclose(direct.gather(positions), [1.0, -2.0, 1.0, -2.0, 0.0], atol=1e-12)
