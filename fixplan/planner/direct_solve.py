@@ -73,7 +73,8 @@ class DirectSolver:
         #: Clarabel's status of the last solve.
         self.status = ""
         self._dual = np.zeros(0)
-        #: The last solution and the parameter vector it was solved with.
+        #: The last solution and the parameter vector it was solved with (the caller's array,
+        #: not a copy: :meth:`gather` reads it before the caller writes new values into it).
         self._last = (np.zeros(0), np.zeros(0))
 
     @classmethod
@@ -160,7 +161,7 @@ class DirectSolver:
 
     def solved(self, *, accept_inaccurate: bool = False, vector: np.ndarray | None = None) -> bool:
         """Solve with the parameters' current values (or those of the parameter ``vector``);
-        the answer is then read with :meth:`solve`'s values or :meth:`gather`.
+        the answer is then read with :meth:`values` or :meth:`gather`.
 
         A linear program goes to the warm-started dual simplex first, and to Clarabel where the
         simplex gives up (:mod:`fixplan.planner.dual_simplex`). ``False`` when Clarabel does not

@@ -680,7 +680,7 @@ class _Reader:
     :meth:`~fixplan.planner.direct_solve.DirectSolver.gather`: the normal forces ``(C, K)``,
     friction loads ``(D, K)`` and, where they are variables, the multiples ``(K,)``, flattened
     in that order (``scale``: the constant multiples of a force objective instead). Read so in
-    about 3 µs, where the values by variable id take 15."""
+    about 5.5 µs, where the values by variable id take 17."""
 
     positions: np.ndarray
     normal_shape: tuple[int, int]
