@@ -113,22 +113,20 @@ class StayingInContact:
         normal_forces = np.asarray(normal_forces, dtype=float)
         words = np.empty((normal_forces.shape[1], self._words), dtype=np.uint64)
         _PRESSED(normal_forces, self._decided, FRICTION_SET_RTOL, words)
-        group = np.array(
-            [self._group(words[j], normal_forces[:, j]) for j in range(len(words))], dtype=np.intp
-        )
+        group = np.array([self._group(row) for row in words], dtype=np.intp)
         out = np.empty(np.shape(twists))
         _KEPT(np.asarray(twists, dtype=float), self._projections, group,
               np.asarray(towards, dtype=float), out)  # fmt: skip
         return out
 
-    def _group(self, words: np.ndarray, normal_forces: np.ndarray) -> int:
-        """The index of the projection of the pressed contacts (``words``, see
-        :func:`pressed_contacts`) at ``normal_forces`` ``(C,)``."""
+    def _group(self, words: np.ndarray) -> int:
+        """The index of the projection of the pressed contacts whose bits are ``words`` (see
+        :func:`pressed_contacts`)."""
         key = words.tobytes()
         found = self._index.get(key)
         if found is None:
-            size = max(np.abs(normal_forces).max(), 1e-300)
-            pressed = self._decided & (normal_forces > FRICTION_SET_RTOL * size)
+            bits = np.unpackbits(words.astype("<u8").view(np.uint8), bitorder="little")
+            pressed = bits[: len(self._decided)].astype(bool)
             found = 0
             if pressed.any():
                 _, singular, basis = np.linalg.svd(self._normal_map[:, pressed].T)
