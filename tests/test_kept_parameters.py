@@ -70,21 +70,30 @@ def assert_same(plan, reference, rtol):
 def through_cvxpy(planner):
     """``planner`` with its parameters set through cvxpy on every solve (no kept vector)."""
     planner._runner._again = lambda *args: (False, None)
+    planner._runner.with_sense = lambda *args: None
     return planner
 
 
 @pytest.fixture
 def kept_solves(monkeypatch):
-    """Counts the solves that went through the kept vector."""
-    counts = {"kept": 0}
-    again = Runner._again
+    """Counts the solves that went through the kept vector (``"kept"``), and those of them that
+    only wrote a sense into it (``"sense"``)."""
+    counts = {"kept": 0, "sense": 0}
+    again, with_sense = Runner._again, Runner.with_sense
 
     def counted(self, *args):
         tried, result = again(self, *args)
         counts["kept"] += result is not None
         return tried, result
 
+    def counted_sense(self, *args):
+        result = with_sense(self, *args)
+        counts["kept"] += result is not None
+        counts["sense"] += result is not None
+        return result
+
     monkeypatch.setattr(Runner, "_again", counted)
+    monkeypatch.setattr(Runner, "with_sense", counted_sense)
     return counts
 
 
@@ -96,13 +105,32 @@ def test_re_solves_with_their_analysis_match_solves_set_through_cvxpy(model, kep
     for load in loads[:3]:
         planner.solve(load)
         reference.solve(load)
-    kept_solves["kept"] = 0
+    kept_solves.update(kept=0, sense=0)
     for load in loads[3:]:
         plan = planner.solve(load)
         assert_same(plan, reference.solve(load), RTOL[model])
     # Of the force solve and the two fixed-force solves of each analysis, those whose force
-    # unit did not change (37 of 63 here).
+    # unit did not change (37 of 63 here); every minimising solve of an analysis follows the
+    # maximising one of the same loads, and only writes its sense.
     assert kept_solves["kept"] >= len(loads[3:])
+    assert kept_solves["sense"] == len(loads[3:])
+
+
+def test_a_sense_alone_is_written_only_for_the_loads_and_forces_the_kept_vector_holds():
+    loads = path(6)
+    planner = Planner(fixture("pyramid", loads[0]))
+    for load in loads[:5]:
+        plan = planner.solve(load)
+    runner = planner._runner
+    wrenches = planner.problem.task_wrenches(loads[4])
+    planned = {5: plan.forces["clamp-top"], 6: plan.forces["clamp-side"]}
+    highest = runner.with_sense("check", wrenches, planned, 1.0)
+    lowest = runner.with_sense("check", wrenches, planned, -1.0)
+    assert (lowest["scale"][0], highest["scale"][0]) == pytest.approx(plan.held_intervals["cut"])
+    other = planner.problem.task_wrenches(loads[5])
+    assert runner.with_sense("check", other, planned, 1.0) is None
+    assert runner.with_sense("check", wrenches, {5: planned[5] * 1.1, 6: planned[6]}, 1.0) is None
+    assert runner.with_sense("check", wrenches, planned, 1.0, np.ones(7, dtype=bool)) is None
 
 
 def test_disabled_contacts_are_part_of_the_kept_state(kept_solves):
@@ -144,6 +172,24 @@ def test_written_parameters_give_the_vector_of_set_parameters():
     assert direct.method == "dual simplex"
     # x >= (1 + 2, 3 + 4, 5 - 1.5): the sum is 13.5.
     assert direct.objective_value == pytest.approx(13.5, rel=1e-14)
+
+
+def test_a_written_parameter_of_the_constraints_renews_them_and_a_cost_parameter_does_not():
+    x = cp.Variable(2)
+    bound, weight = cp.Parameter(2), cp.Parameter(nonneg=True)
+    problem = cp.Problem(cp.Minimize(weight * x[0] + x[1]), [x >= bound, x <= 10.0])
+    bound.value, weight.value = np.array([1.0, -2.0]), 1.0
+    problem.solve(solver=cp.CLARABEL)
+    problem.solve(solver=cp.CLARABEL)
+    direct = DirectSolver.create(problem, {})
+    vector = direct.parameter_vector()
+    assert direct.solved(vector=vector)
+    direct.write(vector, weight, -1.0)  # x[0] to its upper bound
+    assert direct.solved(vector=vector)
+    np.testing.assert_allclose(direct.values()[x.id], [10.0, -2.0], atol=1e-9)
+    direct.write(vector, bound, [1.0, 3.0])
+    assert direct.solved(vector=vector)
+    np.testing.assert_allclose(direct.values()[x.id], [10.0, 3.0], atol=1e-9)
 
 
 @pytest.mark.parametrize("model", ["pyramid", "ellipsoid"])

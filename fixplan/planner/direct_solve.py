@@ -53,7 +53,11 @@ class DirectSolver:
         self._problem = problem
         self._solver = solver
         self._simplex = simplex
-        self._matrix = None  # the dense A of the simplex, while it does not change
+        #: The last parameter vector's ``(vector, A values, b)``, kept until :meth:`write` puts
+        #: a parameter of ``A`` or ``b`` into it (a sense writes only ``q``), and the dense A of
+        #: the simplex with the values it was made from.
+        self._constraints = (None, None, None)
+        self._dense = (None, None)
         #: (column of the load multiple, its simplex) where only that column of A changes,
         #: and the last matrix of that simplex with its b.
         self._scaled = None
@@ -140,6 +144,8 @@ class DirectSolver:
         if value.shape != parameter.shape:  # (broadcast_to costs 5-8 µs; most fit)
             value = np.broadcast_to(value, parameter.shape)
         vector[entries] = value.ravel(order="F")
+        if vector is self._constraints[0] and self._program.in_constraints(parameter):
+            self._constraints = (None, None, None)
 
     def solve(
         self, *, accept_inaccurate: bool = False, vector: np.ndarray | None = None
@@ -171,7 +177,10 @@ class DirectSolver:
         if vector is None:
             vector = self._program.parameter_vector()
         q, constant = self._program.cost(vector)
-        a, b = self._program.constraints(vector)
+        kept, a, b = self._constraints
+        if kept is not vector:
+            a, b = self._program.constraints(vector)
+            self._constraints = (vector, a, b)
         found = self._simplex_solve(q, a, b)
         if found is not None:
             x, self._dual = found
@@ -214,10 +223,10 @@ class DirectSolver:
         program, or the simplex gave up: Clarabel then solves it)."""
         if self._simplex is None:
             return None
-        matrix = self._matrix
-        if matrix is None:
+        values, matrix = self._dense
+        if values is not a:  # (the same values object: the same matrix, not refactored)
             matrix = self._program.dense(a)
-            self._matrix = matrix if self._program.fixed_a else None
+            self._dense = (a, matrix)
         if self._scaled is not None:
             column = self._scaled[0]
             if q[column] < 0.0 and np.count_nonzero(q) == 1:
@@ -314,6 +323,10 @@ class _Program:
         self._parametric_entries = np.diff(parametric.tocsr().indptr) > 0
         self.fixed_a = not self._parametric_entries.any()
         self._a_map = _for_products(a_map)
+        used = np.diff(a_map[:, : self._size - 1].tocsc().indptr) > 0  # by vector entry
+        self._constraint_parameters = {
+            p.id for p, column, size in self._columns if used[column : column + size].any()
+        }
         #: Where ``A`` is fixed: its values, and the map of ``b`` alone.
         self._fixed_values = None
         if self.fixed_a:
@@ -348,6 +361,10 @@ class _Program:
     def entries(self, parameter) -> slice | None:
         """Where ``parameter``'s values sit in the parameter vector (``None``: not used)."""
         return self._entries.get(parameter.id)
+
+    def in_constraints(self, parameter) -> bool:
+        """Whether ``parameter`` enters ``A`` or ``b`` (else only the cost, or nothing)."""
+        return parameter.id in self._constraint_parameters
 
     def cost(self, vector) -> tuple[np.ndarray, float]:
         """``q`` and the constant of the cost."""

@@ -263,6 +263,9 @@ class Planner:
         on its given forces: one case per distinct column of given forces is solved first, and
         the cases that share a column held at 0 have ``k_min = 0`` without a solve of their own.
         (With squeezable passive contacts every case is solved: their unloading is per case.)
+        Where the last direct solve of ``check`` was of these cases and forces (the maximising
+        solve just before), only the sense is written into its parameter vector
+        (:meth:`~fixplan.planner.runner.Runner.with_sense`).
         """
 
         def minimised(index, report=None):
@@ -273,6 +276,12 @@ class Planner:
             )  # fmt: skip
 
         cases = wrenches.shape[1]
+        if not self.squeeze_contacts:
+            found = self._runner.with_sense("check", wrenches, given, -1.0, disabled)
+            if found is not None:
+                if progress is not None:
+                    progress(cases, cases)
+                return found
         if self.squeeze_contacts or not given or cases == 1:
             return minimised(np.arange(cases), progress)
         columns = np.vstack([np.broadcast_to(v, (cases,)) for v in given.values()])

@@ -269,6 +269,7 @@ class Runner:
         stacked, direct = self._built[key], self._direct[key]
         vector = kept.vector
         direct.write(vector, stacked.task, wrenches / unit)
+        kept.wrenches = wrenches.copy()
         state = _given_state(given)
         if state is None or state != kept.given:
             # Into the Parameters too: the plan's normal forces read the given ones from there.
@@ -284,6 +285,30 @@ class Runner:
             kept.sense = sense
         result = self._direct_result(key, stacked, vector)
         return True, None if result is None else _in_newtons(result, unit, objective)
+
+    def with_sense(self, objective, wrenches, given, sense, disabled=None) -> dict | None:
+        """The fixed-force ``objective`` solved again with ``sense`` where the parameter
+        vector of its last direct solve holds these task ``wrenches`` ``(6, K)`` (all in one
+        block) and ``given`` forces (plain numbers), the same contacts ``disabled`` and none
+        unloaded: only the sense is written (the other end of the held intervals just solved).
+        The result in newtons, or ``None`` where this does not apply or the solve fails."""
+        key = (objective, False)
+        kept = self._kept.get(key)
+        if (
+            kept is None
+            or self.osculating
+            or kept.given is None
+            or kept.given != _given_state(given)
+            or kept.disabled != _bytes(disabled)
+            or not np.array_equal(kept.wrenches, wrenches)
+        ):
+            return None
+        stacked, direct = self._built[key], self._direct[key]
+        if sense != kept.sense:
+            direct.write(kept.vector, stacked.sense, float(sense))
+            kept.sense = sense
+        result = self._direct_result(key, stacked, kept.vector)
+        return None if result is None else _in_newtons(result, kept.unit, objective)
 
     def _run_block(
         self, objective, wrenches, given, unloaded, numbers, sense, accurate, disabled,
@@ -317,8 +342,10 @@ class Runner:
         ):
             return result
         capped = result["scale"] >= MAX_SAFETY_FACTOR * (1.0 - CAPPED_BLOCK_RTOL)
+        if not capped.any():
+            return result
         again = np.flatnonzero(~capped)
-        if not capped.any() or again.size == 0:
+        if again.size == 0:
             return result
         # Through this method again where that leaves fewer cases (a case can reach the cap
         # only without its capped block mates, and then blurs the others in turn); not where
@@ -409,7 +436,7 @@ class Runner:
                 if result is not None:
                     if unloaded is None:  # (osculating programs are never solved directly)
                         self._kept[key] = _Kept(unit, _bytes(disabled), _given_state(given),
-                                                float(sense), vector)  # fmt: skip
+                                                float(sense), vector, wrenches.copy())  # fmt: skip
                     return _in_newtons(result, unit, objective)
                 tried = key in self._direct
             if osculating:
@@ -572,13 +599,15 @@ class Runner:
 class _Kept:
     """The parameter ``vector`` of an objective's last direct solve (none unloaded), and what
     it was set for: the force ``unit`` [N], the ``disabled`` contacts (:func:`_bytes`), the
-    ``given`` forces (:func:`_given_state`; ``None``: arrays) and the ``sense``."""
+    ``given`` forces (:func:`_given_state`; ``None``: arrays), the ``sense`` and the task
+    ``wrenches`` ``(6, K)`` [N, N m] (a copy)."""
 
     unit: float
     disabled: bytes | None
     given: tuple | None
     sense: float
     vector: np.ndarray
+    wrenches: np.ndarray
 
 
 def _bytes(disabled: np.ndarray | None) -> bytes | None:
