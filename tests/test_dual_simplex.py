@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from scipy.optimize import linprog
+from test_kept_parameters import clamped_block
 
 from fixplan import pressure
 from fixplan.io.problem_file import load_problem
@@ -142,12 +143,7 @@ def _clamped_block(load):
         ("clamp-top", "clamp", [0.0, 0.0, 0.04], [0, 0, -1], pad),
         ("clamp-side", "clamp", [0.0, 0.04, 0.02], [0, -1, 0], jaw),
     ]
-    contacts = [
-        Contact(name=n, role=r, position=x, normal=v, mu=0.3, model="pyramid", patch=patch)
-        for n, r, x, v, patch in places
-    ]
-    body = Body(mass=3.0, center_of_mass=[0.0, 0.0, 0.02])
-    return Problem(body=body, contacts=contacts, loads=load, objective="min-total-clamp-force")
+    return clamped_block(places, load, model="pyramid", mu=0.3, mass=3.0)
 
 
 def test_cold_starts_of_dually_degenerate_programs_stay_in_the_simplex():

@@ -14,6 +14,17 @@ from fixplan.planner.problem import Body, Contact, Load, Problem
 from fixplan.planner.runner import Runner, _values
 
 
+def clamped_block(places, load, *, model, mu, mass):
+    """A block (centre of mass 20 mm up) held at ``places`` (``(name, role, position, normal,
+    patch)`` each), objective ``min-total-clamp-force``."""
+    contacts = [
+        Contact(name=n, role=r, position=x, normal=v, mu=mu, model=model, patch=patch)
+        for n, r, x, v, patch in places
+    ]
+    body = Body(mass=mass, center_of_mass=[0.0, 0.0, 0.02])
+    return Problem(body=body, contacts=contacts, loads=load, objective="min-total-clamp-force")
+
+
 def fixture(model, load):
     """A block on three pads against two locators, held by a top and a side clamp."""
     pad, jaw = pressure.disk(0.01), pressure.rectangle(0.02, 0.01)
@@ -26,12 +37,7 @@ def fixture(model, load):
         ("clamp-top", "clamp", [0.0, 0.0, 0.04], [0, 0, -1], pad),
         ("clamp-side", "clamp", [0.0, 0.04, 0.02], [0, -1, 0], jaw),
     ]
-    contacts = [
-        Contact(name=n, role=r, position=x, normal=v, mu=0.4, model=model, patch=patch)
-        for n, r, x, v, patch in places
-    ]
-    body = Body(mass=2.0, center_of_mass=[0.0, 0.0, 0.02])
-    return Problem(body=body, contacts=contacts, loads=load, objective="min-total-clamp-force")
+    return clamped_block(places, load, model=model, mu=0.4, mass=2.0)
 
 
 #: Optima of the same program from two warm starts (simplex) or two interior-point runs

@@ -272,7 +272,8 @@ class Runner:
         kept.wrenches = wrenches.copy()
         state = _given_state(given)
         if state is None or state != kept.given:
-            # Into the Parameters too: the plan's normal forces read the given ones from there.
+            # Into the Parameters too: a later solve through cvxpy starts from them (see
+            # _given), and an answer read without a _Reader takes its given forces there.
             def put(parameter, value):
                 assign(parameter, value)
                 direct.write(vector, parameter, value)
