@@ -6,9 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from scipy.optimize import linprog
-from test_kept_parameters import clamped_block
+from test_kept_parameters import bench_fixture
 
-from fixplan import pressure
 from fixplan.io.problem_file import load_problem
 from fixplan.planner.dual_simplex import DualSimplex
 from fixplan.planner.planner import Planner
@@ -129,23 +128,6 @@ def test_planner_re_solves_through_the_simplex_equal_fresh_solves():
         assert plan.utilisation.max() == pytest.approx(fresh.utilisation.max(), rel=1e-6)
 
 
-def _clamped_block(load):
-    """A 120 x 80 x 40 mm block on three pads against two side locators and an end stop, under
-    a top and a side clamp (pyramid models): benchmarks/bench_planner.py's fixture."""
-    pad, jaw = pressure.disk(0.008), pressure.rectangle(0.03, 0.01)
-    places = [
-        ("pad-1", "support", [0.04, 0.0, 0.0], [0, 0, 1], pad),
-        ("pad-2", "support", [-0.04, 0.03, 0.0], [0, 0, 1], pad),
-        ("pad-3", "support", [-0.04, -0.03, 0.0], [0, 0, 1], pad),
-        ("side-1", "locator", [0.03, -0.04, 0.02], [0, 1, 0], jaw),
-        ("side-2", "locator", [-0.03, -0.04, 0.02], [0, 1, 0], jaw),
-        ("end", "locator", [-0.06, 0.0, 0.02], [1, 0, 0], jaw),
-        ("clamp-top", "clamp", [0.0, 0.0, 0.04], [0, 0, -1], pad),
-        ("clamp-side", "clamp", [0.0, 0.04, 0.02], [0, -1, 0], jaw),
-    ]
-    return clamped_block(places, load, model="pyramid", mu=0.3, mass=3.0)
-
-
 def test_cold_starts_of_dually_degenerate_programs_stay_in_the_simplex():
     # The least multiple k_min of the safety analysis is 0 here: its program minimises one
     # variable, and most multipliers of the artificial start are exactly 0. Unperturbed, the
@@ -157,11 +139,13 @@ def test_cold_starts_of_dually_degenerate_programs_stay_in_the_simplex():
                      torque=[0.0, 0.0, 0.8 * np.sin(angle)])]  # fmt: skip
 
     for angle in np.linspace(0.0, 2.0 * np.pi, 12, endpoint=False):
-        planner = Planner(_clamped_block(cut(angle)))
+        planner = Planner(bench_fixture(cut(angle), "pyramid"))
         planner.solve(cut(angle + 0.5))  # (cvxpy's solves; the direct solvers are built)
         plan = planner.solve(cut(angle))  # the fixed-force programs start cold
         assert planner._runner._direct[("check", False)].method == "dual simplex"
-        fresh = Planner(_clamped_block(cut(angle))).solve()  # (through cvxpy and Clarabel)
+        fresh = Planner(
+            bench_fixture(cut(angle), "pyramid")
+        ).solve()  # (through cvxpy and Clarabel)
         low, high = plan.held_intervals["cut"]
         fresh_low, fresh_high = fresh.held_intervals["cut"]
         assert low == pytest.approx(fresh_low, abs=1e-7)

@@ -25,6 +25,23 @@ def clamped_block(places, load, *, model, mu, mass):
     return Problem(body=body, contacts=contacts, loads=load, objective="min-total-clamp-force")
 
 
+def bench_fixture(load, model):
+    """A 120 x 80 x 40 mm block on three pads against two side locators and an end stop, under
+    a top and a side clamp: benchmarks/bench_planner.py's fixture."""
+    pad, jaw = pressure.disk(0.008), pressure.rectangle(0.03, 0.01)
+    places = [
+        ("pad-1", "support", [0.04, 0.0, 0.0], [0, 0, 1], pad),
+        ("pad-2", "support", [-0.04, 0.03, 0.0], [0, 0, 1], pad),
+        ("pad-3", "support", [-0.04, -0.03, 0.0], [0, 0, 1], pad),
+        ("side-1", "locator", [0.03, -0.04, 0.02], [0, 1, 0], jaw),
+        ("side-2", "locator", [-0.03, -0.04, 0.02], [0, 1, 0], jaw),
+        ("end", "locator", [-0.06, 0.0, 0.02], [1, 0, 0], jaw),
+        ("clamp-top", "clamp", [0.0, 0.0, 0.04], [0, 0, -1], pad),
+        ("clamp-side", "clamp", [0.0, 0.04, 0.02], [0, -1, 0], jaw),
+    ]
+    return clamped_block(places, load, model=model, mu=0.3, mass=3.0)
+
+
 def fixture(model, load):
     """A block on three pads against two locators, held by a top and a side clamp."""
     pad, jaw = pressure.disk(0.01), pressure.rectangle(0.02, 0.01)

@@ -89,3 +89,24 @@ def test_the_ellipsoids_support_is_the_norm_of_the_inverse_transpose_factor_time
         np.linalg.solve(factors.transpose(0, 2, 1), twists[:, :, None]), axis=1
     )
     np.testing.assert_allclose(_support(factors, twists), expected[:, 0], rtol=1e-12)
+
+
+@pytest.mark.parametrize("name", FIELDS)
+def test_the_ellipsoid_osculating_where_the_normal_is_a_twist_is_the_one_at_its_point(name):
+    # The forward map's point u = ∇h_1(V) lies on the exact surface with sliding twist V (the
+    # inverse map's answer), and its ellipsoid is the one the inverse map's path gives at u
+    # (checked against finite differences of the gauge above), whose curvature is the Hessian of
+    # Newton's last iterate: about 1e-6 relative from the Hessian at the answer itself.
+    surface = LimitSurface(FIELDS[name], mu=0.4, normal_force=3.0)
+    model = Exact(surface=surface)
+    twists = np.random.default_rng(6).normal(size=(6, 3)) * np.array([1.0, 1.0, 80.0])
+    points, factors = model.osculating_at(twists)
+    excess, on_ray, expected = model.osculating(points)
+    np.testing.assert_allclose(excess, 0.0, atol=1e-12)
+    np.testing.assert_allclose(on_ray, points, rtol=1e-12)
+    sliding = surface.motion(points * surface.normal_force)
+    scale = np.array([1.0, 1.0, 0.01])
+    unit = twists * scale / np.linalg.norm(twists * scale, axis=1, keepdims=True)
+    moved = sliding * scale / np.linalg.norm(sliding * scale, axis=1, keepdims=True)
+    np.testing.assert_allclose(moved, unit, atol=1e-9)
+    np.testing.assert_allclose(factors, expected, atol=1e-5 * np.abs(expected).max())

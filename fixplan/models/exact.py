@@ -195,13 +195,40 @@ class Exact(FrictionModel):
         coordinates (loads over :meth:`_units`), where ``J`` is well conditioned.
         """
         planes, excess, curvature = self._cuts(loads, start, curvature=True)
-        units = self._units()
         points = loads / (1.0 + excess)[:, None]
+        return excess, points, self._osculating_factors(planes, points, curvature)
+
+    def osculating_at(self, twists: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The ellipsoid that osculates the exact set at its point with the normal ``V``.
+
+        Parameters
+        ----------
+        twists : numpy.ndarray
+            ``(K, 3)`` nonzero load-space twists ``V`` [m/s, m/s, rad/s] (not checked).
+
+        Returns
+        -------
+        points : numpy.ndarray
+            ``(K, 3)`` the surface points ``u = ∇h_1(V)`` [-, -, m] (the forward map: no
+            Newton iterations, unlike :meth:`osculating`).
+        factors : numpy.ndarray
+            ``(K, 3, 3)`` as :meth:`osculating` gives them at ``u``.
+        """
+        force = self.surface.normal_force
+        points = self.surface.load(twists) / force
+        support = np.einsum("kc,kc->k", points, twists)  # h_1(V) = ∇h_1(V) · V
+        curvature = self.surface._trusted_hessians(twists) * (support / force)[:, None, None]
+        return points, self._osculating_factors(twists / support[:, None], points, curvature)
+
+    def _osculating_factors(self, planes, points, curvature) -> np.ndarray:
+        """Factors ``(K, 3, 3)`` of the ellipsoids with the tangent ``planes`` at ``points``
+        ``(K, 3)`` and the support Hessians ``curvature`` ``(K, 3, 3)`` at the planes."""
+        units = self._units()
         a, u = planes * units, points / units  # normalised plane and point, a · u = 1
-        curvature /= units[None, :, None] * units[None, None, :]
-        factors = np.empty((len(loads), 3, 3))
+        curvature = curvature / (units[None, :, None] * units[None, None, :])
+        factors = np.empty((len(points), 3, 3))
         _OSCULATING_FACTORS(a, u, curvature, factors)
-        return excess, points, factors / units[None, None, :]
+        return factors / units[None, None, :]
 
     def planes(self, twists: np.ndarray) -> np.ndarray:
         r"""Tangent planes :math:`a \cdot L \le N`, ``a = V / h_1(V)``, of the exact set at the
