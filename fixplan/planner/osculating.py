@@ -277,7 +277,8 @@ class OsculatingPool(ExactContacts):
             loose[rows] = weights[e, cases[rows]] * (1.0 - reach / exact) > SUPPORT_RTOL
             if loose[rows].any():
                 short = rows[loose[rows]]
-                found = model.osculating_at(twist[loose[rows]])[1]
+                points = model.surface.load(twist[loose[rows]]) / model.surface.normal_force
+                found = model.osculating(points)[2]
                 usable = np.all(np.isfinite(found), axis=(1, 2))
                 self._factors[e, cases[short[usable]]] = found[usable] * (1.0 + MARGIN)
         return not loose.any()
