@@ -46,8 +46,7 @@ def relaxed_forces(planner: Planner, chosen: int) -> np.ndarray | None:
     stacked = build(problem, planner.layout, objective, cases, squeeze=False)
     assign(stacked.task, problem.task_wrenches())
     set_units(stacked, problem.body.weight_wrench)
-    set_given(stacked, {i: c.force for i, c in enumerate(problem.contacts) if c.force is not None},
-              cases)  # fmt: skip
+    set_given(stacked, {i: c.force for i, c in enumerate(problem.contacts) if c.force is not None})
     if stacked.sense is not None:
         assign(stacked.sense, 1.0)
     penalty, weights = 0, []

@@ -242,7 +242,7 @@ class DirectSolver:
         (the same stationarity: ``a_c^T z' = |q_c| t``)."""
         column, simplex = self._scaled
         scaled, last = self._scaled_matrix
-        if not np.array_equal(b, last):  # the same object while b stays: no refactoring
+        if not same_values(b, last):  # (the same b: no refactoring)
             scaled = matrix.copy()
             scaled[:, column] = -b
             self._scaled_matrix = (scaled, b.copy())
@@ -370,16 +370,16 @@ class _Program:
         """``q`` and the constant of the cost."""
         if self._fixed_cost is not None:
             return self._fixed_cost
-        full = self._q @ vector
+        full = self._q.dot(vector)
         return full[: self.variables], float(full[self.variables])
 
     def constraints(self, vector) -> tuple[np.ndarray, np.ndarray]:
         """Clarabel's ``A`` as its values in the fixed pattern (:meth:`matrix`) and ``b``:
         cvxpy's ``A x + b`` in the cones is ``b_C - A_C x`` with ``A_C = -A``, ``b_C = b``."""
         if self._fixed_values is not None:
-            return self._fixed_values, self._b_map @ vector
+            return self._fixed_values, self._b_map.dot(vector)
         b = np.zeros(self._a_shape[0])
-        values = self._a_map @ vector
+        values = self._a_map.dot(vector)
         b[self._a_rows[self._split :]] = values[self._split :]
         return -values[: self._split], b
 
@@ -404,8 +404,15 @@ class _Program:
         return sp.csc_matrix((values, *pattern), shape=self._a_shape)
 
 
+def same_values(a: np.ndarray | None, b: np.ndarray | None) -> bool:
+    """Whether arrays ``a`` and ``b`` (or ``None``) hold the same values bit for bit: 0.3 µs
+    on small arrays, where ``np.array_equal`` takes 3."""
+    return a is not None and b is not None and a.shape == b.shape and a.tobytes() == b.tobytes()
+
+
 def _for_products(matrix: sp.csr_array):
-    """``matrix`` as it is fastest to multiply: dense up to ``DENSE_MAX_ENTRIES`` entries."""
+    """``matrix`` as it is fastest to multiply (with ``.dot``, 1 µs less than ``@`` on small
+    arrays): dense up to ``DENSE_MAX_ENTRIES`` entries."""
     return matrix.toarray() if matrix.shape[0] * matrix.shape[1] <= DENSE_MAX_ENTRIES else matrix
 
 

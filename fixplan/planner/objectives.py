@@ -40,30 +40,46 @@ def objective_expression(objective, *, scale, sense, clamps, fingers, free_force
     return cp.Minimize(cp.sum_squares(free_forces))  # min-squared-normal-force
 
 
-def objective_value(objective: str, forces: dict, roles: dict, scale: np.ndarray) -> float:
-    """The objective's value for the active ``forces`` (name -> float or ``(K,)``) [N or N²];
-    for the fixed-force objectives the smallest task-load multiple ``scale``."""
-    if objective in FIXED_FORCE_OBJECTIVES:
-        return float(scale.min())
-    if objective == "min-total-clamp-force":
-        clamp = sum(v for k, v in forces.items() if roles[k] == "clamp")
-        fingers = [v for k, v in forces.items() if roles[k] == "finger"]
-        return float(clamp + (np.max(np.sum(fingers, axis=0)) if fingers else 0.0))
-    per_case = [np.broadcast_to(v, scale.shape) for v in forces.values()]
-    if objective == "min-max-normal-force":
-        return float(np.max(per_case))
-    if objective == "min-total-normal-force":
-        return float(np.max(np.sum(per_case, axis=0)))
-    return float(np.sum(np.square(per_case)))
+class ActiveForces:
+    """The active contacts of a problem: their normal forces and a force objective's value.
 
+    Parameters
+    ----------
+    contacts : sequence of Contact
+        The problem's contacts; rows of the normal forces below are in their order.
+    """
 
-def active_forces(contacts, normal: np.ndarray) -> dict:
-    """The active normal forces of ``normal`` ``(C, K)`` [N] by contact name: a clamp's one
-    force, a finger's ``(K,)`` (negative solver noise clipped to 0)."""
-    forces = {}
-    for i, contact in enumerate(contacts):
-        if contact.role == "clamp":
-            forces[contact.name] = max(float(normal[i, 0]), 0.0)
-        elif contact.role == "finger":
-            forces[contact.name] = np.maximum(normal[i], 0.0)
-    return forces
+    def __init__(self, contacts):
+        #: (row, name, whether a clamp) of each clamp and finger.
+        self._active = [
+            (i, c.name, c.role == "clamp")
+            for i, c in enumerate(contacts)
+            if c.role in ("clamp", "finger")
+        ]
+        self._clamps = [name for _, name, clamp in self._active if clamp]
+        self._fingers = [name for _, name, clamp in self._active if not clamp]
+
+    def forces(self, normal: np.ndarray) -> dict:
+        """The active normal forces of ``normal`` ``(C, K)`` [N] by contact name: a clamp's one
+        force, a finger's ``(K,)`` (negative solver noise clipped to 0)."""
+        forces = {}
+        for i, name, clamp in self._active:
+            forces[name] = max(float(normal[i, 0]), 0.0) if clamp else np.maximum(normal[i], 0.0)
+        return forces
+
+    def value(self, objective: str, forces: dict, scale: np.ndarray) -> float:
+        """The objective's value for the active ``forces`` (from :meth:`forces`) [N or N²];
+        for the fixed-force objectives the smallest task-load multiple ``scale`` ``(K,)``."""
+        if objective in FIXED_FORCE_OBJECTIVES:
+            return float(scale.min())
+        if objective == "min-total-clamp-force":
+            total = sum(forces[name] for name in self._clamps)
+            if self._fingers:
+                total += np.max(np.sum([forces[name] for name in self._fingers], axis=0))
+            return float(total)
+        per_case = [np.broadcast_to(value, scale.shape) for value in forces.values()]
+        if objective == "min-max-normal-force":
+            return float(np.max(per_case))
+        if objective == "min-total-normal-force":
+            return float(np.max(np.sum(per_case, axis=0)))
+        return float(np.sum(np.square(per_case)))  # min-squared-normal-force

@@ -31,7 +31,7 @@ from fixplan.planner.analysis import StayingInContact, analyse_cases
 from fixplan.planner.certificate import certificate
 from fixplan.planner.contact_models import contact_model
 from fixplan.planner.friction_use import FrictionUse
-from fixplan.planner.objectives import active_forces, objective_value
+from fixplan.planner.objectives import ActiveForces
 from fixplan.planner.plan import Plan
 from fixplan.planner.problem import (
     FIXED_FORCE_OBJECTIVES,
@@ -45,6 +45,7 @@ from fixplan.planner.squeeze import squeezing
 from fixplan.planner.stacking import REFINE, ContactLayout
 from fixplan.planner.unloading import SqueezeFree
 from fixplan.planner.verify import Verifier
+from fixplan.surface.point_kernel import compiled_scalar
 from fixplan.tolerances import MULTIPLE_ATOL
 
 
@@ -89,7 +90,8 @@ class Planner:
         spread = np.linalg.norm(positions - problem.body.center_of_mass, axis=1)
         self.length_scale = float(max(spread.max(), 1e-3))
         self._passive = np.array([c.role in PASSIVE_ROLES for c in problem.contacts])
-        self._roles = {c.name: c.role for c in problem.contacts}  # (in the contacts' order)
+        self._contact_names = tuple(c.name for c in problem.contacts)
+        self._active = ActiveForces(problem.contacts)
         #: The given normal forces [N] by contact index.
         self._given_forces = {
             i: c.force for i, c in enumerate(problem.contacts) if c.force is not None
@@ -104,7 +106,6 @@ class Planner:
         self._friction_component = np.concatenate(
             [np.arange(1, 1 + part.stop - part.start) for part in self.layout.slices]
         ).astype(np.intp)
-        self._friction_places: dict[int, np.ndarray] = {}  # see _wrenches
         self._staying = StayingInContact(self.layout.normal_map, self._passive, self.length_scale)
         self._verify = Verifier(problem, self.layout, self.friction_use, self.length_scale)
         passive_map = self.layout.normal_map[:, self._passive]
@@ -188,7 +189,7 @@ class Planner:
             notes += problems
             for note in problems:
                 warnings.warn(note, stacklevel=2)
-        forces = active_forces(self.problem.contacts, result["normal"])
+        forces = self._active.forces(result["normal"])
         if objective in FIXED_FORCE_OBJECTIVES:
             extra = self._intervals(result, wrenches, given, progress, off)
         elif analyse and status == "optimal":
@@ -203,7 +204,7 @@ class Planner:
                 extra = {}
         else:
             extra = {}
-        value = objective_value(objective, forces, self._roles, result["scale"])
+        value = self._active.value(objective, forces, result["scale"])
         if objective in FIXED_FORCE_OBJECTIVES and "safety_factor" in extra:
             value = extra["safety_factor"]
         notes += self._squeeze_notes(squeezed)
@@ -333,7 +334,7 @@ class Planner:
             status=status,
             objective=self.problem.objective,
             objective_value=value,
-            contact_names=tuple(self._roles),
+            contact_names=self._contact_names,
             solver=solver,
             solve_time=time.perf_counter() - start,
             warnings=tuple(notes),
@@ -342,15 +343,25 @@ class Planner:
 
     def _wrenches(self, normal, friction) -> np.ndarray:
         """The contact wrenches ``(C, K, 4)`` of ``normal`` ``(C, K)`` and ``friction``
-        ``(D, K)``, the friction loads placed by flat indices kept per ``K``."""
-        contacts, cases = normal.shape
-        if cases not in self._friction_places:
-            owner, component = self._friction_owner[:, None], self._friction_component[:, None]
-            self._friction_places[cases] = (owner * cases + np.arange(cases)) * 4 + component
-        out = np.zeros((contacts, cases, 4))
-        out[:, :, 0] = normal
-        out.reshape(-1)[self._friction_places[cases]] = friction
+        ``(D, K)``."""
+        out = np.zeros((*normal.shape, 4))
+        _PLACED(normal, friction, self._friction_owner, self._friction_component, out)
         return out
+
+
+def placed_wrenches(normal, friction, owner, component, out):  # pragma: no cover - compiled
+    """Put ``normal`` ``(C, K)`` and ``friction`` ``(D, K)`` into the contact wrenches ``out``
+    ``(C, K, 4)``: row ``d`` of ``friction`` is component ``component[d]`` of contact
+    ``owner[d]``."""
+    for i in range(normal.shape[0]):
+        for k in range(normal.shape[1]):
+            out[i, k, 0] = normal[i, k]
+    for d in range(friction.shape[0]):
+        for k in range(friction.shape[1]):
+            out[owner[d], k, component[d]] = friction[d, k]
+
+
+_PLACED = compiled_scalar(placed_wrenches)
 
 
 def solve(problem: Problem, *, solver: str | None = None) -> Plan:

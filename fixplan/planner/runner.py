@@ -28,7 +28,7 @@ import cvxpy as cp
 import numpy as np
 
 from fixplan.errors import FixplanError, InvalidArgumentError
-from fixplan.planner.direct_solve import DirectSolver
+from fixplan.planner.direct_solve import DirectSolver, same_values
 from fixplan.planner.osculating import OsculatingPool, smooth
 from fixplan.planner.parameters import assign
 from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, Problem
@@ -252,8 +252,8 @@ class Runner:
     def _again(self, objective, wrenches, given, sense, unloaded, disabled) -> tuple:
         """A block straight through the direct solver of ``objective``, its parameters written
         into the parameter vector of its last direct solve (:class:`_Kept`) rather than set
-        through cvxpy: the task wrenches, and the given forces (also set, see ``put``) and
-        ``sense`` where they changed. Applies where that solve was in the same force unit, with
+        through cvxpy: the task wrenches, and the given forces and ``sense`` where they
+        changed. Applies where that solve was in the same force unit, with
         the same contacts disabled and none ``unloaded``.
 
         Returns ``(tried, result)``: whether the direct solver was tried, and the result in
@@ -272,15 +272,20 @@ class Runner:
         kept.wrenches = wrenches.copy()
         state = _given_state(given)
         if state is None or state != kept.given:
-            # Into the Parameters too: a later solve through cvxpy starts from them (see
-            # _given), and an answer read without a _Reader takes its given forces there.
+            # Into the vector alone: the Parameters keep the forces that _given names (a solve
+            # through cvxpy sets them again where these differ), but where an answer is read
+            # from them (no _Reader).
+            through_parameters = self._readers[key] is None
+
             def put(parameter, value):
-                assign(parameter, value)
+                if through_parameters:
+                    assign(parameter, value)
                 direct.write(vector, parameter, value)
 
-            set_given(stacked, given, wrenches.shape[1], unit, put=put)
+            set_given(stacked, given, unit, put=put)
             kept.given = state
-            self._given[key] = None if state is None else (unit, state)
+            if through_parameters:
+                self._given[key] = None if state is None else (unit, state)
         if stacked.sense is not None and sense != kept.sense:
             direct.write(vector, stacked.sense, float(sense))
             kept.sense = sense
@@ -301,7 +306,7 @@ class Runner:
             or kept.given is None
             or kept.given != _given_state(given)
             or kept.disabled != _bytes(disabled)
-            or not np.array_equal(kept.wrenches, wrenches)
+            or not same_values(kept.wrenches, wrenches)
         ):
             return None
         stacked, direct = self._built[key], self._direct[key]
@@ -502,7 +507,7 @@ class Runner:
         scalars = _given_state(given)
         state = None if scalars is None else (unit, scalars)
         if state is None or self._given.get(key) != state:
-            set_given(stacked, given, wrenches.shape[1], unit)  # (not again for the same forces)
+            set_given(stacked, given, unit)  # (not again for the same forces)
             self._given[key] = state
         if stacked.sense is not None:
             assign(stacked.sense, float(sense))

@@ -380,22 +380,21 @@ def set_units(stacked: Stacked, weight_wrench: np.ndarray, unit: float = 1.0) ->
         assign(parameter, forces / unit)
 
 
-def set_given(
-    stacked: Stacked, values: dict, cases: int, unit: float = 1.0, put: Callable = assign
-) -> None:
+def set_given(stacked: Stacked, values: dict, unit: float = 1.0, put: Callable = assign) -> None:
     """Set the given normal forces [N] in the force ``unit`` [N] of the program: ``values``
-    maps contact index -> float or ``(cases,)``; through ``put(parameter, value)`` (default
+    maps contact index -> float or ``(K,)`` (its load cases); through ``put(parameter, value)`` (default
     :func:`~fixplan.planner.parameters.assign`)."""
     fingers, clamps = stacked.given_fingers, stacked.given_clamps
     finger_values = None if fingers is None else np.zeros(fingers.shape)
     clamp_values = None if clamps is None else np.zeros(clamps.shape)
     for i, (kind, row) in stacked.given.items():
         # A planned force may come back from the solver as -1e-12 N: given forces are >= 0.
-        value = np.maximum(values[i], 0.0) / unit
+        value = values[i]
         if kind == "finger":
-            finger_values[row] = np.broadcast_to(value, (cases,))
-        else:
-            clamp_values[row] = float(np.ravel(value)[0])
+            finger_values[row] = np.maximum(value, 0.0) / unit
+        else:  # (in floats: numpy's calls cost more than the arithmetic)
+            first = value if isinstance(value, float) else float(np.ravel(value)[0])
+            clamp_values[row] = max(first, 0.0) / unit
     if fingers is not None:
         put(fingers, finger_values)
     if clamps is not None:

@@ -15,7 +15,7 @@ import functools
 
 import numpy as np
 
-from fixplan.planner.objectives import active_forces, objective_value
+from fixplan.planner.objectives import ActiveForces
 from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, PASSIVE_ROLES, Problem
 from fixplan.planner.runner import Runner
 from fixplan.planner.squeeze import choose_unloading, same_contact_trials, squeeze_members
@@ -43,6 +43,7 @@ class SqueezeFree:
         self._runner = runner
         self._passive = np.array([c.role in PASSIVE_ROLES for c in problem.contacts])
         self._passive_map = layout.normal_map[:, self._passive]
+        self._active = ActiveForces(problem.contacts)
         self._length_scale = float(length_scale)
         self._squeezable = squeezable
         self._alone: Runner | None = None  # one load case, to rate unloadings
@@ -191,6 +192,5 @@ class SqueezeFree:
     def _force_objective(self, objective: str, result: dict) -> float:
         """The value [N or N²] of the force ``objective`` (or its refining stage) at the active
         forces of ``result``."""
-        forces = active_forces(self.problem.contacts, result["normal"])
-        roles = {c.name: c.role for c in self.problem.contacts}
-        return objective_value(objective.removesuffix(REFINE), forces, roles, result["scale"])
+        forces = self._active.forces(result["normal"])
+        return self._active.value(objective.removesuffix(REFINE), forces, result["scale"])

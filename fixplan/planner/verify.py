@@ -52,8 +52,8 @@ class Verifier:
         normal, friction, scale = answer["normal"], answer["friction"], answer["scale"]
         sizes = np.empty((2, normal.shape[1]))
         ratios = np.empty((2, normal.shape[1]))
-        relative = _EQUILIBRIUM(*self._maps, normal, friction, wrenches, scale, self._gravity,
-                                self._length_scale, sizes, ratios)  # fmt: skip
+        relative, largest = _EQUILIBRIUM(*self._maps, normal, friction, wrenches, scale,
+                                         self._gravity, self._length_scale, sizes, ratios)  # fmt: skip
         problems = []
         if relative > EQUILIBRIUM_RTOL:
             for row, unit in ((0, "N"), (1, "N m")):
@@ -65,17 +65,17 @@ class Verifier:
                         f"{ratio * size:.3g} {unit}, over {EQUILIBRIUM_RTOL:g} of the "
                         f"wrenches involved ({size:.3g} {unit})"
                     )
-        known = answer.get("known_use")
-        return relative, problems + self._friction_problems(normal, friction, known)
-
-    def _friction_problems(self, normal, friction, known) -> list[str]:
-        """Pulling contacts, friction without normal force and friction outside its set
-        (``known``: the uses already computed for some contacts, see :class:`FrictionUse`)."""
-        scale_force = max(LARGEST_MAGNITUDE(normal), 1e-12)
+        scale_force = max(largest, 1e-12)
         noise = FRICTION_SET_RTOL * scale_force
-        use = self._use(friction, normal, noise=noise, known=known)
-        if not _TROUBLED(normal, use, noise):
-            return []
+        use = self._use(friction, normal, noise=noise, known=answer.get("known_use"))
+        if _TROUBLED(normal, use, noise):
+            problems += self._friction_problems(normal, use, noise, scale_force)
+        return relative, problems
+
+    def _friction_problems(self, normal, use, noise, scale_force) -> list[str]:
+        """Pulling contacts, friction without normal force and friction outside its set, at
+        the uses ``use`` ``(C, K)`` of the loads, in words (``noise`` [N]: the solver's, and
+        ``scale_force`` [N]: the largest normal force)."""
         problems = [
             f"contact {self._names[i]!r} pulls: normal force {normal[i].min():.3g} N"
             for i in np.flatnonzero((normal < -noise).any(axis=1))
@@ -104,7 +104,8 @@ def equilibrium(normal_map, friction_map, normal, friction, wrenches, scale, gra
                 length_scale, sizes, ratios):  # fmt: skip  # pragma: no cover - compiled
     """Each case's largest residual of force and of moment (rows of ``ratios`` ``(2, K)``)
     over the size of its wrench terms (``sizes``: the largest force and moment of any term,
-    moments at least force × ``length_scale``); returns the largest ratio (0 for no case)."""
+    moments at least force × ``length_scale``); returns the largest ratio (0 for no case) and
+    the largest magnitude of ``normal`` (see :func:`largest_magnitude`)."""
     largest = 0.0
     for k in range(normal.shape[1]):
         residual = np.zeros(6)
@@ -130,7 +131,7 @@ def equilibrium(normal_map, friction_map, normal, friction, wrenches, scale, gra
         for ratio in (ratios[0, k], ratios[1, k]):
             if not ratio <= largest:  # (NaN propagates)
                 largest = ratio
-    return largest
+    return largest, LARGEST_MAGNITUDE(normal)
 
 
 def largest_magnitude(values):  # pragma: no cover - compiled
