@@ -56,8 +56,9 @@ def analyse_cases(
     motions = dict.fromkeys(names)
     if dual is not None:
         twists = staying(dual, normal, wrenches)
+        moving = twists.any(axis=0).tolist()
         for j in range(len(high)):
-            if high[j] < np.inf and twists[:, j].any():
+            if high[j] < np.inf and moving[j]:
                 motions[names[j]] = Screw.from_twist(twists[:, j], length_scale)
     noise = FRICTION_SET_RTOL * max(LARGEST_MAGNITUDE(normal), 1e-12)
     known = highest.get("known_use")
