@@ -253,8 +253,8 @@ class Runner:
         """A block straight through the direct solver of ``objective``, its parameters written
         into the parameter vector of its last direct solve (:class:`_Kept`) rather than set
         through cvxpy: the task wrenches, and the given forces and ``sense`` where they
-        changed. Applies where that solve was in the same force unit, with
-        the same contacts disabled and none ``unloaded``.
+        changed. Applies where that solve was in the same force unit, with the same contacts
+        disabled and none ``unloaded``.
 
         Returns ``(tried, result)``: whether the direct solver was tried, and the result in
         newtons (``None`` where it did not apply or failed: the caller then takes the full

@@ -382,8 +382,8 @@ def set_units(stacked: Stacked, weight_wrench: np.ndarray, unit: float = 1.0) ->
 
 def set_given(stacked: Stacked, values: dict, unit: float = 1.0, put: Callable = assign) -> None:
     """Set the given normal forces [N] in the force ``unit`` [N] of the program: ``values``
-    maps contact index -> float or ``(K,)`` (its load cases); through ``put(parameter, value)`` (default
-    :func:`~fixplan.planner.parameters.assign`)."""
+    maps contact index -> float or ``(K,)`` (one per load case); through ``put(parameter,
+    value)`` (default :func:`~fixplan.planner.parameters.assign`)."""
     fingers, clamps = stacked.given_fingers, stacked.given_clamps
     finger_values = None if fingers is None else np.zeros(fingers.shape)
     clamp_values = None if clamps is None else np.zeros(clamps.shape)

@@ -160,7 +160,7 @@ def troubled(normal, use, noise):  # pragma: no cover - compiled
     return False
 
 
-_EQUILIBRIUM = compiled_scalar(equilibrium)
-_TROUBLED = compiled_scalar(troubled)
 #: :func:`largest_magnitude` compiled (also for the analysis).
 LARGEST_MAGNITUDE = compiled_scalar(largest_magnitude)
+_EQUILIBRIUM = compiled_scalar(equilibrium)
+_TROUBLED = compiled_scalar(troubled)
