@@ -405,8 +405,8 @@ class _Program:
 
 
 def same_values(a: np.ndarray | None, b: np.ndarray | None) -> bool:
-    """Whether arrays ``a`` and ``b`` (or ``None``) hold the same values bit for bit: 0.3 µs
-    on small arrays, where ``np.array_equal`` takes 3."""
+    """Whether arrays ``a`` and ``b`` (or ``None``) hold the same values bit for bit: a sixth
+    of the time of ``np.array_equal`` on small arrays (0.7-0.9 µs against 5.2)."""
     return a is not None and b is not None and a.shape == b.shape and a.tobytes() == b.tobytes()
 
 

@@ -483,7 +483,7 @@ class Runner:
         own = self._ellipsoids.get((objective, sense, int(case)))
         latest = self._ellipsoids.get(int(case))
         for kept in (own, latest):
-            if kept is not None and np.array_equal(kept[0], wrench):
+            if kept is not None and same_values(kept[0], wrench):
                 return kept[1]
         kept = own if own is not None else latest
         return None if kept is None else kept[1]
