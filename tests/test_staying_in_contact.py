@@ -55,9 +55,15 @@ def test_the_kept_motions_are_the_reference_projections(count):
     staying = StayingInContact(normal_map, decided, LENGTH_SCALE)
     expected = reference(normal_map, decided, twists, normal_forces, towards)
     for _ in range(2):  # the second time from the kept projections
-        found = staying(twists, normal_forces, towards)
+        found, moving = staying(twists, normal_forces, towards)
         np.testing.assert_allclose(found, expected, rtol=RTOL, atol=RTOL * np.abs(twists).max())
     assert not found[:, 3].any()
+    assert moving == found.any(axis=0).tolist()
+    # Other pressed sets right after (the groups of the last call are not reused).
+    shuffled = normal_forces[:, ::-1].copy()
+    found, _ = staying(twists, shuffled, towards)
+    expected = reference(normal_map, decided, twists, shuffled, towards)
+    np.testing.assert_allclose(found, expected, rtol=RTOL, atol=RTOL * np.abs(twists).max())
 
 
 def test_a_twist_the_pressed_contacts_forbid_is_kept_as_it_is():
@@ -70,8 +76,9 @@ def test_a_twist_the_pressed_contacts_forbid_is_kept_as_it_is():
                               [0.0, 0.0, 1.0]).T  # fmt: skip
     lift = np.array([[0.0, 0.0, 1.0, 0.0, 0.0, 0.0]]).T
     staying = StayingInContact(normal_map, np.ones(3, dtype=bool), LENGTH_SCALE)
-    found = staying(lift, np.full((3, 1), 10.0), lift)
+    found, moving = staying(lift, np.full((3, 1), 10.0), lift)
     np.testing.assert_array_equal(found, lift)
+    assert moving == [True]
 
 
 def test_pressed_sets_that_differ_beyond_the_first_64_contacts_are_told_apart():
@@ -85,7 +92,7 @@ def test_pressed_sets_that_differ_beyond_the_first_64_contacts_are_told_apart():
     normal_forces[1, 0] = normal_forces[65, 1] = 10.0
     twist = rng.normal(size=6)
     twists = np.column_stack([twist, twist])
-    found = StayingInContact(normal_map, decided, LENGTH_SCALE)(twists, normal_forces, twists)
+    found, _ = StayingInContact(normal_map, decided, LENGTH_SCALE)(twists, normal_forces, twists)
     np.testing.assert_allclose(
         found, reference(normal_map, decided, twists, normal_forces, twists), rtol=RTOL, atol=RTOL
     )

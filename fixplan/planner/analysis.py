@@ -45,7 +45,7 @@ def analyse_cases(
     """Plan fields from the maximising (``highest``) and minimising (``lowest``) fixed-force
     solves of every load case; ``staying`` projects the motions onto those that keep the
     contacts whose normal force the solve chose in contact."""
-    names = tuple(load.name for load in problem.loads)
+    names = [load.name for load in problem.loads]
     k_max = np.array(highest["scale"], dtype=float)
     k_min = np.zeros_like(k_max) if lowest is None else np.array(lowest["scale"], dtype=float)
     held = np.empty(len(k_max), dtype=np.bool_)
@@ -55,8 +55,7 @@ def analyse_cases(
     high, low = k_max.tolist(), k_min.tolist()
     motions = dict.fromkeys(names)
     if dual is not None:
-        twists = staying(dual, normal, wrenches)
-        moving = twists.any(axis=0).tolist()
+        twists, moving = staying(dual, normal, wrenches)
         for j in range(len(high)):
             if high[j] < np.inf and moving[j]:
                 motions[names[j]] = Screw.from_twist(twists[:, j], length_scale)
@@ -65,13 +64,13 @@ def analyse_cases(
     utilisation = np.minimum(friction_use(friction, normal, noise=noise, known=known), 1.0)
     return {
         "safety_factors": dict(zip(names, high, strict=True)),
-        "safety_factor": float(k_max.min()),
+        "safety_factor": min(high),
         "held_intervals": dict(zip(names, zip(low, high, strict=True), strict=True)),
         "held": dict(zip(names, held.tolist(), strict=True)),
         "motions": motions,
         "utilisation": utilisation,
         "critical_load": names[critical],
-        "critical_contact": problem.contacts[int(np.argmax(utilisation[:, critical]))].name,
+        "critical_contact": problem.contacts[int(utilisation[:, critical].argmax())].name,
     }
 
 
@@ -104,21 +103,28 @@ class StayingInContact:
         #: contacts (its words of bits) among them.
         self._projections = np.eye(6)[None]  # (none pressed: the identity)
         self._index: dict[bytes, int] = {}
+        #: The words of the last call's pressed contacts and their groups.
+        self._last: tuple[bytes, np.ndarray] = (b"", np.zeros(0, dtype=np.intp))
 
     def __call__(
         self, twists: np.ndarray, normal_forces: np.ndarray, towards: np.ndarray
-    ) -> np.ndarray:
+    ) -> tuple[np.ndarray, list[bool]]:
         """The twists ``(6, K)`` kept in contact at the normal forces ``(C, K)`` [N], each signed
         to do nonnegative power with its wrench of ``towards`` ``(6, K)`` (the dual's sign is
-        the solver's choice)."""
+        the solver's choice), and whether each is not zero."""
         normal_forces = np.asarray(normal_forces, dtype=float)
+        twists = np.asarray(twists, dtype=float)
         words = np.empty((normal_forces.shape[1], self._words), dtype=np.uint64)
         _PRESSED(normal_forces, self._decided, FRICTION_SET_RTOL, words)
-        group = np.array([self._group(row) for row in words], dtype=np.intp)
-        out = np.empty(np.shape(twists))
-        _KEPT(np.asarray(twists, dtype=float), self._projections, group,
-              np.asarray(towards, dtype=float), out)  # fmt: skip
-        return out
+        key = words.tobytes()
+        last_key, group = self._last
+        if key != last_key:  # (a control loop's cases keep their pressed contacts)
+            group = np.array([self._group(row) for row in words], dtype=np.intp)
+            self._last = (key, group)
+        out = np.empty(twists.shape)
+        moving = np.empty(twists.shape[1], dtype=np.bool_)
+        _KEPT(twists, self._projections, group, np.asarray(towards, dtype=float), out, moving)
+        return out, moving.tolist()
 
     def _group(self, words: np.ndarray) -> int:
         """The index of the projection of the pressed contacts whose bits are ``words`` (see
@@ -152,9 +158,12 @@ def pressed_contacts(normal, decided, rtol, words):  # pragma: no cover - compil
                 words[j, c // 64] |= np.uint64(1) << np.uint64(c % 64)
 
 
-def kept_in_contact(twists, projections, group, towards, out):  # pragma: no cover - compiled
+def kept_in_contact(
+    twists, projections, group, towards, out, moving
+):  # pragma: no cover - compiled
     """``out[:, j]``: ``projections[group[j]] @ twists[:, j]`` where that keeps at least half of
-    its norm (a quarter of its square), else the twist itself; signed towards ``towards``."""
+    its norm (a quarter of its square), else the twist itself; signed towards ``towards``;
+    ``moving[j]``: whether it is not zero."""
     for j in range(twists.shape[1]):
         projection = projections[group[j]]
         given, kept = 0.0, 0.0
@@ -172,6 +181,9 @@ def kept_in_contact(twists, projections, group, towards, out):  # pragma: no cov
             power += towards[row, j] * out[row, j]
         if power < 0.0:
             out[:, j] = -out[:, j]
+        moving[j] = False
+        for row in range(6):
+            moving[j] = moving[j] or out[row, j] != 0.0
 
 
 def multiples(k_max, k_min, held, cap, atol, held_rtol):  # pragma: no cover - compiled

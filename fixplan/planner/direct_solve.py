@@ -8,10 +8,12 @@ loads and friction bounds of the contact-spring steps of :mod:`fixplan.motion.co
 and the linear cost ``q``. This module applies those maps itself, keeps one Clarabel solver whose
 ``A``, ``b`` and ``q`` are updated in place, and reads the variables and the multipliers of
 equality constraints from the solution vectors. Linear programs (pyramid models) are solved by a
-warm-started dual simplex (:mod:`fixplan.planner.dual_simplex`) instead, with Clarabel where that
-gives up. It checks itself against cvxpy's answer when it
-is built and refuses (returns ``None``) where its assumptions do not hold (a parametric ``P``,
-cones Clarabel's direct path does not cover, cvxpy internals it does not recognise).
+warm-started dual simplex (:mod:`fixplan.planner.dual_simplex`) instead, and small cone programs
+in standard form (ellipsoid and cone models) by a compiled interior-point method
+(:mod:`fixplan.planner.cone_interior_point`), with Clarabel where either gives up. It checks
+itself against cvxpy's answer when it is built and refuses (returns ``None``) where its
+assumptions do not hold (a parametric ``P``, cones Clarabel's direct path does not cover, cvxpy
+internals it does not recognise).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import cvxpy as cp
 import numpy as np
 import scipy.sparse as sp
 
+from fixplan.planner.cone_interior_point import ConeInteriorPoint
 from fixplan.planner.dual_simplex import DualSimplex
 
 #: Largest relative difference from cvxpy's own answer accepted when the direct path is built.
@@ -35,6 +38,10 @@ SIMPLEX_MAX_ENTRIES = 100_000
 #: variables (one load case of an 8-contact fixture has 28-35).
 SIMPLEX_MAX_CHANGING_VARIABLES = 64
 
+#: Cone programs up to this many constraint-matrix entries go to the compiled interior-point
+#: method where they fit it (one 8-contact case with ellipsoid models has 38 x 32).
+INTERIOR_MAX_ENTRIES = 20_000
+
 #: What :meth:`DirectSolver.gather` reads at position -1.
 _ZERO = np.zeros(1)
 
@@ -49,20 +56,22 @@ class DirectSolver:
     Build with :meth:`create` after ``problem`` was solved once by cvxpy with Clarabel.
     """
 
-    def __init__(self, problem, solver, program, offsets, equalities, simplex=None):
+    def __init__(self, problem, solver, program, offsets, equalities, simplex=None, interior=None):
         self._problem = problem
         self._solver = solver
         self._simplex = simplex
+        self._interior = interior
         #: The last parameter vector's ``(vector, A values, b)``, kept until :meth:`write` puts
         #: a parameter of ``A`` or ``b`` into it (a sense writes only ``q``), and the dense A of
-        #: the simplex with the values it was made from.
+        #: the simplex or the interior-point method with the values it was made from.
         self._constraints = (None, None, None)
         self._dense = (None, None)
         #: (column of the load multiple, its simplex) where only that column of A changes,
         #: and the last matrix of that simplex with its b.
         self._scaled = None
         self._scaled_matrix = (None, None)
-        #: What solved the last problem: ``"dual simplex"`` or ``"CLARABEL"``.
+        #: What solved the last problem: ``"dual simplex"``, ``"interior point"`` or
+        #: ``"CLARABEL"``.
         self.method = ""
         self._program = program
         #: Where each variable sits in Clarabel's x: (id, start, stop, shape).
@@ -115,7 +124,16 @@ class DirectSolver:
             small = small and len(q) <= SIMPLEX_MAX_CHANGING_VARIABLES
         if not dims.soc and program.quadratic.nnz == 0 and small:
             simplex = DualSimplex(dims.zero, changing=not program.fixed_a)
-        direct = cls(problem, solver, program, offsets, equalities, simplex)
+        interior = None
+        if (
+            simplex is None
+            and program.quadratic.nnz == 0
+            and len(b) * len(q) <= INTERIOR_MAX_ENTRIES
+        ):
+            pattern = program.dense(np.ones_like(a))
+            if ConeInteriorPoint.fits(dims.zero, pattern):
+                interior = ConeInteriorPoint(dims.zero, dims.nonneg, dims.soc, pattern, settings)
+        direct = cls(problem, solver, program, offsets, equalities, simplex, interior)
         columns = program.parametric_columns()
         if simplex is not None and len(columns) == 1:  # one load multiple times the loads
             direct._scaled = (int(columns[0]), DualSimplex(dims.zero, changing=True))
@@ -169,9 +187,10 @@ class DirectSolver:
         """Solve with the parameters' current values (or those of the parameter ``vector``);
         the answer is then read with :meth:`values` or :meth:`gather`.
 
-        A linear program goes to the warm-started dual simplex first, and to Clarabel where the
-        simplex gives up (:mod:`fixplan.planner.dual_simplex`). ``False`` when Clarabel does not
-        report the problem solved (or almost solved, with ``accept_inaccurate``); :attr:`status`
+        A linear program goes to the warm-started dual simplex first, a cone program in
+        standard form to the compiled interior-point method, and to Clarabel where either gives
+        up (:mod:`fixplan.planner.dual_simplex`, :mod:`fixplan.planner.cone_interior_point`).
+        ``False`` when Clarabel does not report the problem solved (or almost solved, with ``accept_inaccurate``); :attr:`status`
         says why (use cvxpy then: it turns infeasibility into certificates).
         """
         if vector is None:
@@ -182,10 +201,13 @@ class DirectSolver:
             a, b = self._program.constraints(vector)
             self._constraints = (vector, a, b)
         found = self._simplex_solve(q, a, b)
+        method = "dual simplex"
+        if found is None and self._interior is not None:
+            found, method = self._interior.solve(q, self._dense_matrix(a), b), "interior point"
         if found is not None:
             x, self._dual = found
             self._optimum = (q, x, constant)
-            self.status, self.method = "Solved", "dual simplex"
+            self.status, self.method = "Solved", method
         else:
             update = {"q": q, "b": b}
             if not self._program.fixed_a:
@@ -223,15 +245,20 @@ class DirectSolver:
         program, or the simplex gave up: Clarabel then solves it)."""
         if self._simplex is None:
             return None
-        values, matrix = self._dense
-        if values is not a:  # (the same values object: the same matrix, not refactored)
-            matrix = self._program.dense(a)
-            self._dense = (a, matrix)
+        matrix = self._dense_matrix(a)
         if self._scaled is not None:
             column = self._scaled[0]
             if q[column] < 0.0 and np.count_nonzero(q) == 1:
                 return self._scaled_solve(matrix, q, b)
         return self._simplex.solve(matrix, q, b)
+
+    def _dense_matrix(self, a) -> np.ndarray:
+        """Clarabel's ``A`` from its values ``a``, dense (kept while ``a`` is the same object)."""
+        values, matrix = self._dense
+        if values is not a:
+            matrix = self._program.dense(a)
+            self._dense = (a, matrix)
+        return matrix
 
     def _scaled_solve(self, matrix, q, b) -> tuple[np.ndarray, np.ndarray] | None:
         r"""The largest load multiple ``k`` (column ``c``, cost ``q_c < 0``), through the

@@ -73,9 +73,10 @@ class Plan:
         Why the status is ``"inaccurate"``, and other caveats.
     solver : str
         The solver that produced the answer, with its method in parentheses where it matters:
-        ``"dual simplex (direct)"``, ``"CLARABEL (direct)"``, and for exact friction models
-        ``"CLARABEL (osculating ellipsoids)"`` or ``"CLARABEL (cutting planes)"``; blocks solved
-        differently are listed, separated by commas.
+        ``"dual simplex (direct)"``, ``"interior point (direct)"``, ``"CLARABEL (direct)"``,
+        and for exact friction models ``"CLARABEL (osculating ellipsoids)"`` or
+        ``"CLARABEL (cutting planes)"``; blocks solved differently are listed, separated by
+        commas.
     solve_time : float
         Wall time of the solve(s) [s].
     """

@@ -177,7 +177,7 @@ class Planner:
             notes += self._squeeze_notes(squeezed)
             return self._plan(status, None, result["solver"], start, notes, fields)
         residual, problems = self._verify(result, wrenches)
-        if problems and result["solver"].startswith(("CLARABEL", "dual simplex")):
+        if problems and result["solver"].startswith(("CLARABEL", "dual simplex", "interior point")):
             retry = self._squeeze_free(
                 objective, wrenches, given, squeezed, accurate=True, disabled=off
             )

@@ -66,7 +66,7 @@ class Screw:
         if spin * length_scale <= TRANSLATION_RTOL * speed:
             return cls(
                 twist=np.array([vx, vy, vz, 0.0, 0.0, 0.0]),
-                direction=np.array([vx, vy, vz]) / speed,
+                direction=np.array([vx / speed, vy / speed, vz / speed]),
                 point=None,
                 pitch=float("inf"),
                 length_scale=length_scale,
@@ -75,8 +75,8 @@ class Screw:
         point = [wy * vz - wz * vy, wz * vx - wx * vz, wx * vy - wy * vx]
         return cls(
             twist=np.array([vx, vy, vz, wx, wy, wz]),
-            direction=np.array([wx, wy, wz]) / spin,
-            point=np.array(point) / squared,
+            direction=np.array([wx / spin, wy / spin, wz / spin]),
+            point=np.array([point[0] / squared, point[1] / squared, point[2] / squared]),
             pitch=(wx * vx + wy * vy + wz * vz) / squared,
             length_scale=length_scale,
         )

@@ -211,12 +211,14 @@ def _compiled(function):
         )
 
 
-def compiled_scalar(function):
+def compiled_scalar(function, *, inline: bool = False):
     """``function`` compiled once, serial, cached like :func:`_compiled`: a building block that
-    compiled loops call per twist."""
+    compiled loops call per twist. With ``inline``, compiled loops that call it compile its body
+    into theirs (no call: small functions called in tight loops)."""
     folder = _writable_cache_dir()
     with _cached_in(folder):
-        return numba.njit(**_JIT, cache=folder is not None)(function)
+        options = {**_JIT, "cache": folder is not None, "inline": "always" if inline else "never"}
+        return numba.njit(**options)(function)
 
 
 _POINT_TERMS = compiled_scalar(point_terms)

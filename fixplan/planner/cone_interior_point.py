@@ -1,0 +1,501 @@
+r"""A compiled interior-point method for the small second-order cone programs of re-solves.
+
+With ellipsoid or cone models, the planner's programs are, in Clarabel's form,
+
+.. math:: \min q^T x \quad\text{s.t.}\quad A_E x = b_E,\quad h - G x \in K
+          = \mathbb{R}_+^{l} \times \mathcal{Q}^{d_1} \times \dots
+
+where every row of ``G`` holds one entry and every variable one row: each variable is a
+scaled coordinate of one cone (a normal force, a friction force, a moment). In the cone
+coordinates ``s = h - G x`` the program is in standard form,
+``min c^T s`` s.t. ``F s = f``, ``s`` in ``K``, with ``p`` (six per load case) equality rows.
+Its primal-dual interior-point method needs one ``p x p`` system per step,
+``F W^2 F^T`` (``W`` the Nesterov-Todd scaling), where Clarabel factorises the whole KKT
+system: about 8 of its iterations of 20 µs each for one 8-contact case.
+
+The method is the infeasible-start path-following method with Mehrotra's predictor and
+corrector (as in CVXOPT's ``coneqp`` and SDPT3), compiled in one call. Small pivots of the
+Cholesky factorisation of ``F W^2 F^T`` are replaced by a huge number (Wright's modified
+Cholesky factorisation for interior-point methods: that direction is dropped), as the system
+grows ill-conditioned near the optimum. Its stopping rule is Clarabel's: residuals and
+duality gap below ``TOL_FEAS`` and ``TOL_GAP_*`` of the data's size.
+
+It finds optima only: where the program looks infeasible or unbounded, or the method makes no
+progress (``MAX_ITERATIONS``, a tiny step), it gives up and the caller asks Clarabel, which
+also returns the certificates.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fixplan.surface.point_kernel import compiled_scalar
+
+#: Stopping tolerances by Clarabel's names, and its defaults: primal and dual residuals
+#: relative to the data's size, and the duality gap absolute and relative to the objective.
+TOLERANCES = {"tol_feas": 1e-8, "tol_gap_abs": 1e-8, "tol_gap_rel": 1e-8}
+#: Iterations before the method gives up (the planner's programs take about 10).
+MAX_ITERATIONS = 50
+#: Fraction of the largest step to the cones' boundary taken.
+STEP_FRACTION = 0.99
+#: A Cholesky pivot below this fraction of its diagonal entry is replaced by ``HUGE_PIVOT``.
+PIVOT_RTOL, HUGE_PIVOT = 1e-30, 1e128
+
+
+class ConeInteriorPoint:
+    """Solves ``min q'x`` s.t. ``A x + s = b``, ``s`` in ``equalities`` zero rows,
+    ``nonnegative`` rows and second-order cones of ``dimensions``, for ``A`` (dense, nonzero
+    where ``pattern`` is) whose cone rows hold one entry each, one per variable (:meth:`fits`).
+    ``settings`` may set :data:`TOLERANCES` (other Clarabel settings are ignored)."""
+
+    def __init__(
+        self,
+        equalities: int,
+        nonnegative: int,
+        dimensions,
+        pattern: np.ndarray,
+        settings: dict | None = None,
+    ):
+        settings = settings or {}
+        self._tolerances = tuple(float(settings.get(k, v)) for k, v in TOLERANCES.items())
+        self._zero = int(equalities)
+        self._nonneg = int(nonnegative)
+        self._dimensions = np.asarray(dimensions, dtype=np.int64).reshape(-1)
+        #: The variable of each cone row.
+        self._variable = np.argmax(pattern[self._zero :] != 0.0, axis=1).astype(np.int64)
+        #: Iterations of the last solve.
+        self.iterations = 0
+
+    @staticmethod
+    def fits(equalities: int, pattern: np.ndarray) -> bool:
+        """Whether the cone rows of ``pattern`` (``A`` or its nonzero pattern) hold one entry
+        each and every variable one such entry."""
+        cone = np.asarray(pattern)[equalities:] != 0.0
+        return (
+            cone.shape[0] == cone.shape[1]
+            and bool(np.all(cone.sum(axis=1) == 1))
+            and bool(np.all(cone.sum(axis=0) == 1))
+        )
+
+    def solve(
+        self, q: np.ndarray, a: np.ndarray, b: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray] | None:
+        """The optimal ``x`` ``(n,)`` and multipliers ``z`` ``(rows,)`` (``q + A^T z = 0``,
+        ``z`` in the dual cones: Clarabel's signs), or ``None`` where the method gave up."""
+        rows, n = a.shape
+        x, z = np.empty(n), np.empty(rows)
+        status, self.iterations = _SOLVE(
+            q, a, b, self._zero, self._nonneg, self._dimensions, self._variable, x, z,
+            *self._tolerances, MAX_ITERATIONS, STEP_FRACTION,
+        )  # fmt: skip
+        return (x, z) if status == 0 else None
+
+
+def solve_standard_form(
+    q, a, b, zero, nonneg, dimensions, variable, x_out, z_out,
+    tol_feas, tol_gap_abs, tol_gap_rel, max_iterations, step_fraction,
+):  # fmt: skip  # pragma: no cover - compiled
+    """Write the optimum of Clarabel's program into ``x_out`` and ``z_out``; ``(0,
+    iterations)`` when solved, else ``(1, iterations)``."""
+    m = a.shape[0] - zero
+    blocks = nonneg + dimensions.shape[0]
+    start = np.empty(blocks, dtype=np.int64)
+    size = np.empty(blocks, dtype=np.int64)
+    row = 0
+    for k in range(blocks):
+        start[k] = row
+        size[k] = 1 if k < nonneg else dimensions[k - nonneg]
+        row += size[k]
+    # Standard form in s = h - G x: x_j = (h_r - s_r) / g_r for the row r of variable j, so
+    # A_E x = b_E is F s = f with F[:, r] = -A_E[:, j] / g_r, f = b_E - sum_r A_E[:, j] h_r / g_r,
+    # and q'x = c's + constant with c_r = -q_j / g_r.
+    f_matrix = np.empty((zero, m))
+    f = b[:zero].copy()
+    c = np.empty(m)
+    gain = np.empty(m)
+    for r in range(m):
+        j = variable[r]
+        g = a[zero + r, j]
+        if g == 0.0:  # (a parametric entry of the pattern that is 0 now)
+            return 1, 0
+        h = b[zero + r]
+        gain[r] = g
+        c[r] = -q[j] / g
+        for e in range(zero):
+            f_matrix[e, r] = -a[e, j] / g
+            f[e] -= a[e, j] * h / g
+    s = np.empty(m)
+    y = np.empty(zero)
+    z = np.empty(m)
+    status, iterations = _STANDARD(f_matrix, f, c, start, size, nonneg, s, y, z, tol_feas,
+                                   tol_gap_abs, tol_gap_rel, max_iterations, step_fraction)  # fmt: skip
+    if status != 0:
+        return status, iterations
+    # Back: x from s; Clarabel's multipliers are -y on the equalities and z on the cones.
+    for r in range(m):
+        x_out[variable[r]] = (b[zero + r] - s[r]) / gain[r]
+        z_out[zero + r] = z[r]
+    for e in range(zero):
+        z_out[e] = -y[e]
+    return 0, iterations
+
+
+def standard_form(
+    f_matrix, f, c, start, size, nonneg, x, y, z,
+    tol_feas, tol_gap_abs, tol_gap_rel, max_iterations, step_fraction,
+):  # fmt: skip  # pragma: no cover - compiled
+    """``min c'x`` s.t. ``F x = f``, ``x`` in the cones (dual: ``max f'y`` s.t.
+    ``F'y + z = c``, ``z`` in the cones): the optimum into ``x``, ``y``, ``z``; ``(0,
+    iterations)`` when solved, else ``(1, iterations)``."""
+    p, m = f_matrix.shape
+    blocks = start.shape[0]
+    degree = float(blocks)
+    normal = np.empty((p, p))  # F F' and then F W^2 F'
+    chol = np.empty((p, p))
+    for i in range(p):
+        for k in range(i + 1):
+            total = 0.0
+            for r in range(m):
+                total += f_matrix[i, r] * f_matrix[k, r]
+            normal[i, k] = total
+            normal[k, i] = total
+    _modified_cholesky(normal, chol)
+    # The start (Mehrotra's): x = F'(FF')^-1 f, y = (FF')^-1 F c, z = c - F'y, both moved
+    # into their cones.
+    t = f.copy()
+    _cholesky_solve(chol, t)
+    for r in range(m):
+        total = 0.0
+        for i in range(p):
+            total += f_matrix[i, r] * t[i]
+        x[r] = total
+    for i in range(p):
+        total = 0.0
+        for r in range(m):
+            total += f_matrix[i, r] * c[r]
+        y[i] = total
+    _cholesky_solve(chol, y)
+    for r in range(m):
+        total = c[r]
+        for i in range(p):
+            total -= f_matrix[i, r] * y[i]
+        z[r] = total
+    _into_cones(x, start, size, nonneg)
+    _into_cones(z, start, size, nonneg)
+    scale_f = _largest(f)
+    scale_c = _largest(c)
+    r_p = np.empty(p)
+    r_d = np.empty(m)
+    beta = np.ones(blocks)
+    v = np.zeros(m)
+    lam = np.zeros(m)
+    scaled = np.empty((p, m))  # W F'
+    dx = np.empty(m)
+    dy = np.empty(p)
+    dz = np.empty(m)
+    jordan = np.empty(m)
+    target = np.empty(m)
+    work = np.empty(m)
+    for iteration in range(max_iterations):
+        for i in range(p):
+            total = f[i]
+            for r in range(m):
+                total -= f_matrix[i, r] * x[r]
+            r_p[i] = total
+        for r in range(m):
+            total = c[r] - z[r]
+            for i in range(p):
+                total -= f_matrix[i, r] * y[i]
+            r_d[r] = total
+        primal, dual, gap = 0.0, 0.0, 0.0
+        for r in range(m):
+            primal += c[r] * x[r]
+            gap += x[r] * z[r]
+        for i in range(p):
+            dual += f[i] * y[i]
+        primal_ok = _largest(r_p) <= tol_feas * max(1.0, scale_f + _largest(x))
+        dual_ok = _largest(r_d) <= tol_feas * max(1.0, scale_c + _largest(z) + _largest(y))
+        bound = tol_gap_abs + tol_gap_rel * min(abs(primal), abs(dual))
+        if primal_ok and dual_ok and gap <= bound and abs(primal - dual) <= bound:
+            return 0, iteration
+        mu = gap / degree
+        if not _scaling(x, z, start, size, nonneg, beta, v, lam):
+            return 1, iteration
+        # F W^2 F' = (W F')' (W F').
+        for i in range(p):
+            for r in range(m):
+                scaled[i, r] = f_matrix[i, r]
+            _apply_scaling(scaled[i], start, size, nonneg, beta, v, False)
+        for i in range(p):
+            for k in range(i + 1):
+                total = 0.0
+                for r in range(m):
+                    total += scaled[i, r] * scaled[k, r]
+                normal[i, k] = total
+                normal[k, i] = total
+        _modified_cholesky(normal, chol)
+        # Predictor: lambda o (W^-1 dx + W dz) = -lambda o lambda, lambda \ d = -lambda.
+        for r in range(m):
+            jordan[r] = -lam[r]
+        _direction(f_matrix, chol, start, size, nonneg, beta, v, r_p, r_d, jordan, dx, dy, dz,
+                   work)  # fmt: skip
+        step = min(1.0, _step(x, dx, start, size, nonneg), _step(z, dz, start, size, nonneg))
+        after = 0.0
+        for r in range(m):
+            after += (x[r] + step * dx[r]) * (z[r] + step * dz[r])
+        sigma = min(1.0, max(0.0, after / gap)) ** 3 if gap > 0.0 else 0.0
+        # Corrector: d = -lambda o lambda - (W^-1 dx_a) o (W dz_a) + sigma mu e.
+        _apply_scaling(dx, start, size, nonneg, beta, v, True)
+        _apply_scaling(dz, start, size, nonneg, beta, v, False)
+        _jordan_product(dx, dz, start, size, work)
+        _jordan_product(lam, lam, start, size, target)
+        for r in range(m):
+            target[r] = -target[r] - work[r]
+        for k in range(blocks):
+            target[start[k]] += sigma * mu
+        _jordan_solve(lam, target, start, size, jordan)
+        _direction(f_matrix, chol, start, size, nonneg, beta, v, r_p, r_d, jordan, dx, dy, dz,
+                   work)  # fmt: skip
+        step = min(_step(x, dx, start, size, nonneg), _step(z, dz, start, size, nonneg))
+        step = min(1.0, step_fraction * step)
+        if step < 1e-10:
+            return 1, iteration
+        for r in range(m):
+            x[r] += step * dx[r]
+            z[r] += step * dz[r]
+        for i in range(p):
+            y[i] += step * dy[i]
+    return 1, max_iterations
+
+
+def _direction(f_matrix, chol, start, size, nonneg, beta, v, r_p, r_d, jordan, dx, dy, dz,
+               work):  # fmt: skip  # pragma: no cover - compiled
+    """The Newton direction of ``F dx = r_p``, ``F'dy + dz = r_d`` and ``W^-1 dx + W dz =
+    jordan``: ``F W^2 F' dy = r_p - F W jordan + F W^2 r_d``, ``dz = r_d - F'dy``,
+    ``dx = W (jordan - W dz)``."""
+    p, m = f_matrix.shape
+    for r in range(m):  # W^2 r_d - W jordan = W (W r_d - jordan)
+        work[r] = r_d[r]
+    _apply_scaling(work, start, size, nonneg, beta, v, False)
+    for r in range(m):
+        work[r] -= jordan[r]
+    _apply_scaling(work, start, size, nonneg, beta, v, False)
+    for i in range(p):
+        total = r_p[i]
+        for r in range(m):
+            total += f_matrix[i, r] * work[r]
+        dy[i] = total
+    _cholesky_solve(chol, dy)
+    for r in range(m):
+        total = r_d[r]
+        for i in range(p):
+            total -= f_matrix[i, r] * dy[i]
+        dz[r] = total
+        dx[r] = total
+    _apply_scaling(dx, start, size, nonneg, beta, v, False)
+    for r in range(m):
+        dx[r] = jordan[r] - dx[r]
+    _apply_scaling(dx, start, size, nonneg, beta, v, False)
+
+
+def _modified_cholesky(matrix, out):  # pragma: no cover - compiled
+    """Lower Cholesky factor of ``matrix``; a pivot below ``PIVOT_RTOL`` of its diagonal entry
+    (a direction the scaling made numerically dependent) becomes ``HUGE_PIVOT``, which drops it
+    from the solves."""
+    n = matrix.shape[0]
+    for j in range(n):
+        total = matrix[j, j]
+        for t in range(j):
+            total -= out[j, t] * out[j, t]
+        if total <= PIVOT_RTOL * abs(matrix[j, j]):
+            total = HUGE_PIVOT
+        pivot = np.sqrt(total)
+        out[j, j] = pivot
+        for i in range(j + 1, n):
+            total = matrix[i, j]
+            for t in range(j):
+                total -= out[i, t] * out[j, t]
+            out[i, j] = total / pivot
+        for i in range(j):
+            out[i, j] = 0.0
+
+
+def _cholesky_solve(chol, rhs):  # pragma: no cover - compiled
+    """``rhs = (L L')^-1 rhs``, in place."""
+    n = chol.shape[0]
+    for i in range(n):
+        total = rhs[i]
+        for t in range(i):
+            total -= chol[i, t] * rhs[t]
+        rhs[i] = total / chol[i, i]
+    for i in range(n - 1, -1, -1):
+        total = rhs[i]
+        for t in range(i + 1, n):
+            total -= chol[t, i] * rhs[t]
+        rhs[i] = total / chol[i, i]
+
+
+def _largest(values):  # pragma: no cover - compiled
+    out = 0.0
+    for value in values:
+        out = max(out, abs(value))
+    return out
+
+
+def _into_cones(values, start, size, nonneg):  # pragma: no cover - compiled
+    """Move ``values`` into the interior of the cones: add ``(1 + a) e`` where ``a`` is the
+    least multiple of ``e`` that reaches the cones (when that is not clearly negative)."""
+    reach = -np.inf
+    norm = 0.0
+    for k in range(start.shape[0]):
+        first = start[k]
+        if k < nonneg:
+            reach = max(reach, -values[first])
+        else:
+            tail = 0.0
+            for r in range(first + 1, first + size[k]):
+                tail += values[r] * values[r]
+            reach = max(reach, np.sqrt(tail) - values[first])
+        for r in range(first, first + size[k]):
+            norm += values[r] * values[r]
+    if reach >= -1e-8 * max(np.sqrt(norm), 1.0):
+        for k in range(start.shape[0]):
+            values[start[k]] += 1.0 + reach
+
+
+def _scaling(s, z, start, size, nonneg, beta, v, lam):  # pragma: no cover - compiled
+    """The Nesterov-Todd scaling of ``s`` and ``z`` (``False`` if either left its cone)."""
+    for k in range(start.shape[0]):
+        first, dim = start[k], size[k]
+        if k < nonneg:
+            if s[first] <= 0.0 or z[first] <= 0.0:
+                return False
+            beta[k] = np.sqrt(s[first] / z[first])
+            lam[first] = np.sqrt(s[first] * z[first])
+            continue
+        s_norm = _hyperbolic_norm(s, first, dim)
+        z_norm = _hyperbolic_norm(z, first, dim)
+        if s_norm <= 0.0 or z_norm <= 0.0:
+            return False
+        beta[k] = np.sqrt(np.sqrt(s_norm / z_norm))
+        inner = 0.0
+        for r in range(first, first + dim):
+            inner += s[r] * z[r]
+        gamma = np.sqrt(0.5 * (1.0 + inner / np.sqrt(s_norm * z_norm)))
+        # w = (s/|s|_J + J z/|z|_J) / (2 gamma); v = (w + e) / sqrt(2 (w_0 + 1)).
+        w0 = (s[first] / np.sqrt(s_norm) + z[first] / np.sqrt(z_norm)) / (2.0 * gamma)
+        scale = 1.0 / np.sqrt(2.0 * (w0 + 1.0))
+        v[first] = (w0 + 1.0) * scale
+        for r in range(first + 1, first + dim):
+            w = (s[r] / np.sqrt(s_norm) - z[r] / np.sqrt(z_norm)) / (2.0 * gamma)
+            v[r] = w * scale
+        # lambda = W z.
+        vz = 0.0
+        for r in range(first, first + dim):
+            vz += v[r] * z[r]
+        lam[first] = beta[k] * (2.0 * v[first] * vz - z[first])
+        for r in range(first + 1, first + dim):
+            lam[r] = beta[k] * (2.0 * v[r] * vz + z[r])
+    return True
+
+
+def _hyperbolic_norm(u, first, dim):  # pragma: no cover - compiled
+    """``u_0^2 - |u_1|^2`` of the cone at ``first``, computed as a product of a sum and a
+    difference (no cancellation near the boundary); 0 or less outside the interior."""
+    tail = 0.0
+    for r in range(first + 1, first + dim):
+        tail += u[r] * u[r]
+    tail = np.sqrt(tail)
+    return (u[first] - tail) * (u[first] + tail) if u[first] > tail else 0.0
+
+
+def _apply_scaling(u, start, size, nonneg, beta, v, inverse):  # pragma: no cover - compiled
+    """``u`` times ``W`` (or ``W^-1`` with ``inverse``), in place."""
+    for k in range(start.shape[0]):
+        _apply_block(u, k, start[k], size[k], nonneg, beta, v, inverse)
+
+
+def _apply_block(u, k, first, dim, nonneg, beta, v, inverse):  # pragma: no cover - compiled
+    """``u`` times block ``k`` of ``W`` (or ``W^-1``), in place at rows ``first...``."""
+    if k < nonneg:
+        u[first] = u[first] / beta[k] if inverse else u[first] * beta[k]
+    elif inverse:  # (2 J v v' J - J) u / beta
+        jvu = v[first] * u[first]
+        for r in range(first + 1, first + dim):
+            jvu -= v[r] * u[r]
+        u[first] = (2.0 * v[first] * jvu - u[first]) / beta[k]
+        for r in range(first + 1, first + dim):
+            u[r] = (-2.0 * v[r] * jvu + u[r]) / beta[k]
+    else:  # beta (2 v v' - J) u
+        vu = 0.0
+        for r in range(first, first + dim):
+            vu += v[r] * u[r]
+        u[first] = beta[k] * (2.0 * v[first] * vu - u[first])
+        for r in range(first + 1, first + dim):
+            u[r] = beta[k] * (2.0 * v[r] * vu + u[r])
+
+
+def _jordan_product(a, b, start, size, out):  # pragma: no cover - compiled
+    """``out = a o b``: ``(a'b, a_0 b_1 + b_0 a_1)`` on each cone, ``a b`` on rows."""
+    for k in range(start.shape[0]):
+        first, dim = start[k], size[k]
+        inner = 0.0
+        for r in range(first, first + dim):
+            inner += a[r] * b[r]
+        for r in range(first + 1, first + dim):
+            out[r] = a[first] * b[r] + b[first] * a[r]
+        out[first] = inner
+
+
+def _jordan_solve(lam, d, start, size, out):  # pragma: no cover - compiled
+    """``out = lambda \\ d``, the ``x`` of ``lambda o x = d``."""
+    for k in range(start.shape[0]):
+        first, dim = start[k], size[k]
+        tail_inner, tail_norm = 0.0, 0.0
+        for r in range(first + 1, first + dim):
+            tail_inner += lam[r] * d[r]
+            tail_norm += lam[r] * lam[r]
+        head = (lam[first] * d[first] - tail_inner) / (lam[first] ** 2 - tail_norm)
+        out[first] = head
+        for r in range(first + 1, first + dim):
+            out[r] = (d[r] - head * lam[r]) / lam[first]
+
+
+def _step(u, d, start, size, nonneg):  # pragma: no cover - compiled
+    """The largest ``t`` with ``u + t d`` in the cones (``inf`` if every ``t >= 0``)."""
+    out = np.inf
+    for k in range(start.shape[0]):
+        first, dim = start[k], size[k]
+        if k < nonneg:
+            if d[first] < 0.0:
+                out = min(out, -u[first] / d[first])
+            continue
+        # (u_0 + t d_0)^2 - |u_1 + t d_1|^2 = c + 2 b t + a t^2.
+        c = _hyperbolic_norm(u, first, dim)
+        a_term = d[first] * d[first]
+        b_term = u[first] * d[first]
+        for r in range(first + 1, first + dim):
+            a_term -= d[r] * d[r]
+            b_term -= u[r] * d[r]
+        if a_term >= 0.0 and d[first] >= 0.0:
+            continue
+        root = np.sqrt(max(b_term * b_term - a_term * c, 0.0))
+        out = min(out, c / (root - b_term)) if root - b_term > 0.0 else 0.0
+    return out
+
+
+# The helpers compiled before the solves that call them.
+_largest = compiled_scalar(_largest, inline=True)
+_into_cones = compiled_scalar(_into_cones)
+_hyperbolic_norm = compiled_scalar(_hyperbolic_norm, inline=True)
+_scaling = compiled_scalar(_scaling)
+_apply_block = compiled_scalar(_apply_block, inline=True)
+_apply_scaling = compiled_scalar(_apply_scaling)
+_jordan_product = compiled_scalar(_jordan_product)
+_jordan_solve = compiled_scalar(_jordan_solve)
+_step = compiled_scalar(_step)
+_modified_cholesky = compiled_scalar(_modified_cholesky)
+_cholesky_solve = compiled_scalar(_cholesky_solve)
+_direction = compiled_scalar(_direction)
+_STANDARD = compiled_scalar(standard_form)
+_SOLVE = compiled_scalar(solve_standard_form)

@@ -1,0 +1,177 @@
+"""The compiled interior-point method for cone programs in standard form, against Clarabel."""
+
+import clarabel
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from fixplan.planner.cone_interior_point import ConeInteriorPoint
+
+TOLERANCES = {"tol_feas": 1e-9, "tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9}
+
+
+def _cones(nonneg, dimensions):
+    """(first row, dimension) of each cone after the equalities."""
+    sizes = [1] * nonneg + list(dimensions)
+    return list(zip(np.cumsum([0, *sizes[:-1]]), sizes, strict=True))
+
+
+def _interior_point(rng, dimension):
+    """A point well inside the second-order cone (a positive number for dimension 1)."""
+    tail = rng.normal(size=dimension - 1)
+    return np.r_[np.linalg.norm(tail) + rng.uniform(0.1, 2.0), tail]
+
+
+def _program(rng, equalities, nonneg, dimensions, *, apex_duals=0):
+    """Clarabel's ``(q, A, b)`` whose cone rows are a scaled, shuffled identity with an offset
+    (``s = h - G x``), feasible with a strictly interior point and bounded by a dual point
+    inside the cones (but for ``apex_duals`` cones whose multipliers are 0: those cones are
+    slack at the optimum, or not, as the program decides)."""
+    cones = _cones(nonneg, dimensions)
+    m = sum(size for _, size in cones)
+    variable = rng.permutation(m)
+    gains = rng.choice([-1.0, 1.0], m) * rng.uniform(0.2, 5.0, m)
+    g = np.zeros((m, m))
+    g[np.arange(m), variable] = gains
+    h = rng.normal(size=m)
+    a_e = rng.normal(size=(equalities, m))
+    slack = np.concatenate([_interior_point(rng, size) for _, size in cones])
+    x0 = np.linalg.solve(g, h - slack)
+    multipliers = [_interior_point(rng, size) for _, size in cones]
+    for k in rng.choice(len(cones), apex_duals, replace=False):
+        multipliers[k] = np.zeros_like(multipliers[k])
+    z0 = np.concatenate(multipliers)
+    q = -(a_e.T @ rng.normal(size=equalities) + g.T @ z0)
+    return q, np.vstack([a_e, g]), np.r_[a_e @ x0, h]
+
+
+def _clarabel(q, a, b, equalities, nonneg, dimensions, tolerances=TOLERANCES):
+    """Clarabel's ``x``, or ``None`` where it does not report the program solved."""
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    for key, value in tolerances.items():
+        setattr(settings, key, value)
+    cones = [clarabel.ZeroConeT(equalities), clarabel.NonnegativeConeT(nonneg)]
+    cones += [clarabel.SecondOrderConeT(d) for d in dimensions]
+    n = len(q)
+    solution = clarabel.DefaultSolver(
+        sp.csc_matrix((n, n)), q, sp.csc_matrix(a), b, cones, settings
+    ).solve()
+    return np.asarray(solution.x) if str(solution.status) == "Solved" else None
+
+
+def _cone_margin(values, equalities, nonneg, dimensions):
+    """The least of ``u_0 - |u_1|`` over the cones (``u`` for a nonnegative row)."""
+    rest = values[equalities:]
+    return min(
+        rest[first] - np.linalg.norm(rest[first + 1 : first + size])
+        for first, size in _cones(nonneg, dimensions)
+    )
+
+
+@pytest.mark.parametrize(
+    ("equalities", "nonneg", "dimensions", "apex_duals"),
+    [
+        (6, 0, [4] * 8, 0),
+        (6, 0, [3] * 8, 2),
+        (3, 4, [3, 5, 2], 1),
+        (1, 5, [], 0),
+        (5, 2, [3] * 6, 3),
+    ],
+)
+def test_optimum_agrees_with_clarabel_and_satisfies_the_optimality_conditions(
+    equalities, nonneg, dimensions, apex_duals
+):
+    rng = np.random.default_rng(len(dimensions) + 10 * nonneg + apex_duals)
+    for _ in range(20):
+        q, a, b = _program(rng, equalities, nonneg, dimensions, apex_duals=apex_duals)
+        solver = ConeInteriorPoint(equalities, nonneg, dimensions, a, TOLERANCES)
+        found = solver.solve(q, a, b)
+        assert found is not None
+        x, z = found
+        reference = _clarabel(q, a, b, equalities, nonneg, dimensions)
+        if reference is not None:  # (Clarabel misses 1 in 1,000 of these at 1e-9)
+            # Both stop at residuals of 1e-9 of the data's size: on 1,000 such programs their
+            # optima were within 1.2e-8 (this method) and 1.9e-8 (Clarabel) of Clarabel's at
+            # 1e-10, relative to the optimum.
+            scale = max(1.0, abs(q @ reference))
+            assert q @ x == pytest.approx(q @ reference, abs=3e-8 * scale)
+        slack = b - a @ x
+        size = 1.0 + np.abs(b).max() + np.abs(x).max()
+        assert np.abs(slack[:equalities]).max() <= 1e-8 * size
+        assert _cone_margin(slack, equalities, nonneg, dimensions) >= -1e-8 * size
+        assert np.abs(q + a.T @ z).max() <= 1e-8 * (1.0 + np.abs(q).max() + np.abs(z).max())
+        assert _cone_margin(z, equalities, nonneg, dimensions) >= 0.0
+        assert slack[equalities:] @ z[equalities:] <= 1e-8 * max(1.0, abs(q @ x))  # complementary
+
+
+def test_an_infeasible_program_is_given_up():
+    """``x >= 1`` (``s = -1 + x``) and ``x <= 0`` through the equality ``x + t = 0`` with
+    ``t >= 0``: no point; the caller then asks Clarabel for the certificate."""
+    q = np.array([1.0, 0.0])
+    a = np.array([[1.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
+    b = np.array([0.0, -1.0, 0.0])
+    assert ConeInteriorPoint(1, 2, [], a).solve(q, a, b) is None
+
+
+def test_an_unbounded_program_is_given_up():
+    """``min -x`` with ``x >= 0`` and ``x - t = 0``, ``t >= 0``."""
+    q = np.array([-1.0, 0.0])
+    a = np.array([[1.0, -1.0], [-1.0, 0.0], [0.0, -1.0]])
+    b = np.zeros(3)
+    assert ConeInteriorPoint(1, 2, [], a).solve(q, a, b) is None
+
+
+def test_a_zero_where_the_pattern_has_an_entry_is_given_up():
+    rng = np.random.default_rng(3)
+    q, a, b = _program(rng, 2, 1, [3])
+    solver = ConeInteriorPoint(2, 1, [3], a)
+    a = a.copy()
+    a[2, np.flatnonzero(a[2])[0]] = 0.0
+    assert solver.solve(q, a, b) is None
+
+
+def test_only_cone_rows_of_one_entry_each_one_per_variable_fit():
+    identity = np.vstack([np.ones((2, 3)), -np.eye(3)])
+    assert ConeInteriorPoint.fits(2, identity)
+    assert ConeInteriorPoint.fits(2, identity[[0, 1, 3, 4, 2]])  # (rows of the cones permuted)
+    two_in_a_row = identity.copy()
+    two_in_a_row[2, 1] = 1.0
+    assert not ConeInteriorPoint.fits(2, two_in_a_row)
+    free_variable = np.vstack([np.ones((2, 4)), np.c_[-np.eye(3), np.zeros(3)]])
+    assert not ConeInteriorPoint.fits(2, free_variable)
+
+
+def test_the_scaling_is_nesterov_todds():
+    """``W z = W^-1 s = lambda`` with ``W`` symmetric and ``W (J) W = (s'Js / z'Jz)^(1/2) J``
+    on each cone (``J = diag(1, -1, ...)``), for points deep inside and near the boundary."""
+    from fixplan.planner.cone_interior_point import _apply_scaling, _scaling
+
+    rng = np.random.default_rng(5)
+    dimensions = [1, 1, 3, 4, 6]
+    start = np.array([0, 1, 2, 5, 9], dtype=np.int64)
+    size = np.array(dimensions, dtype=np.int64)
+    for margin in (1.0, 1e-6):
+        s = np.concatenate([_interior_point(rng, d) for d in dimensions])
+        z = np.concatenate([_interior_point(rng, d) for d in dimensions])
+        s[start[2:]] = np.array([np.linalg.norm(s[f + 1 : f + d]) + margin
+                                 for f, d in zip(start[2:], size[2:], strict=True)])  # fmt: skip
+        beta, v, lam = np.ones(5), np.zeros(15), np.zeros(15)
+        assert _scaling(s, z, start, size, 2, beta, v, lam)
+        scaled_z, unscaled_s = z.copy(), s.copy()
+        _apply_scaling(scaled_z, start, size, 2, beta, v, False)
+        _apply_scaling(unscaled_s, start, size, 2, beta, v, True)
+        np.testing.assert_allclose(scaled_z, lam, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(unscaled_s, lam, rtol=1e-9, atol=1e-12)
+        for first, d in zip(start[2:], size[2:], strict=True):
+            w = np.empty((d, d))
+            for column in range(d):
+                unit = np.zeros(15)
+                unit[first + column] = 1.0
+                _apply_scaling(unit, start, size, 2, beta, v, False)
+                w[:, column] = unit[first : first + d]
+            j = np.diag(np.r_[1.0, -np.ones(d - 1)])
+            rows = slice(first, first + d)
+            ratio = np.sqrt((s[rows] @ j @ s[rows]) / (z[rows] @ j @ z[rows]))
+            np.testing.assert_allclose(w, w.T, atol=1e-9 * np.abs(w).max())
+            np.testing.assert_allclose(w @ j @ w, ratio * j, atol=1e-9 * np.abs(w).max() ** 2)
