@@ -22,27 +22,34 @@ def _interior_point(rng, dimension):
     return np.r_[np.linalg.norm(tail) + rng.uniform(0.1, 2.0), tail]
 
 
-def _program(rng, equalities, nonneg, dimensions, *, apex_duals=0):
-    """Clarabel's ``(q, A, b)`` whose cone rows are a scaled, shuffled identity with an offset
-    (``s = h - G x``), feasible with a strictly interior point and bounded by a dual point
-    inside the cones (but for ``apex_duals`` cones whose multipliers are 0: those cones are
-    slack at the optimum, or not, as the program decides)."""
+def _program(rng, equalities, nonneg, dimensions, *, apex_duals=0, constants=0, repeats=0):
+    """Clarabel's ``(q, A, b)`` whose cone rows (``s = h - G x``) hold one entry each, one
+    per variable, in shuffled order and scaled, but for ``constants`` rows without one and
+    ``repeats`` rows of variables that have another row already. Feasible with a strictly
+    interior point; bounded by a dual point inside the cones (but for ``apex_duals`` cones
+    whose multipliers are 0: those cones are slack at the optimum, or not, as the program
+    decides)."""
     cones = _cones(nonneg, dimensions)
     m = sum(size for _, size in cones)
-    variable = rng.permutation(m)
-    gains = rng.choice([-1.0, 1.0], m) * rng.uniform(0.2, 5.0, m)
-    g = np.zeros((m, m))
-    g[np.arange(m), variable] = gains
-    h = rng.normal(size=m)
-    a_e = rng.normal(size=(equalities, m))
+    n = m - constants - repeats
+    rows = rng.permutation(m)
+    variable = np.full(m, -1)
+    variable[rows[:n]] = rng.permutation(n)
+    variable[rows[n : n + repeats]] = rng.integers(0, n, repeats)
+    g = np.zeros((m, n))
+    placed = variable >= 0
+    g[placed, variable[placed]] = rng.choice([-1.0, 1.0], placed.sum()) * rng.uniform(
+        0.2, 5.0, placed.sum()
+    )
+    a_e = rng.normal(size=(equalities, n))
     slack = np.concatenate([_interior_point(rng, size) for _, size in cones])
-    x0 = np.linalg.solve(g, h - slack)
+    x0 = rng.normal(size=n)
     multipliers = [_interior_point(rng, size) for _, size in cones]
     for k in rng.choice(len(cones), apex_duals, replace=False):
         multipliers[k] = np.zeros_like(multipliers[k])
     z0 = np.concatenate(multipliers)
     q = -(a_e.T @ rng.normal(size=equalities) + g.T @ z0)
-    return q, np.vstack([a_e, g]), np.r_[a_e @ x0, h]
+    return q, np.vstack([a_e, g]), np.r_[a_e @ x0, slack + g @ x0]
 
 
 def _clarabel(q, a, b, equalities, nonneg, dimensions, tolerances=TOLERANCES):
@@ -70,21 +77,26 @@ def _cone_margin(values, equalities, nonneg, dimensions):
 
 
 @pytest.mark.parametrize(
-    ("equalities", "nonneg", "dimensions", "apex_duals"),
+    ("equalities", "nonneg", "dimensions", "apex_duals", "constants", "repeats"),
     [
-        (6, 0, [4] * 8, 0),
-        (6, 0, [3] * 8, 2),
-        (3, 4, [3, 5, 2], 1),
-        (1, 5, [], 0),
-        (5, 2, [3] * 6, 3),
+        (6, 0, [4] * 8, 0, 0, 0),  # (the planner's bare re-solve: 8 contacts, 1 case)
+        (6, 0, [3] * 8, 2, 0, 0),
+        (3, 4, [3, 5, 2], 1, 0, 0),
+        (1, 5, [], 0, 0, 0),
+        (5, 2, [3] * 6, 3, 0, 0),
+        (6, 2, [4] * 8, 0, 2, 1),  # (its analysis: given normal forces, a bounded multiple)
+        (4, 3, [3, 3, 4], 1, 3, 3),
     ],
 )
 def test_optimum_agrees_with_clarabel_and_satisfies_the_optimality_conditions(
-    equalities, nonneg, dimensions, apex_duals
+    equalities, nonneg, dimensions, apex_duals, constants, repeats
 ):
-    rng = np.random.default_rng(len(dimensions) + 10 * nonneg + apex_duals)
+    rng = np.random.default_rng(len(dimensions) + 10 * nonneg + apex_duals + 100 * constants)
     for _ in range(20):
-        q, a, b = _program(rng, equalities, nonneg, dimensions, apex_duals=apex_duals)
+        q, a, b = _program(
+            rng, equalities, nonneg, dimensions,
+            apex_duals=apex_duals, constants=constants, repeats=repeats,
+        )  # fmt: skip
         solver = ConeInteriorPoint(equalities, nonneg, dimensions, a, TOLERANCES)
         found = solver.solve(q, a, b)
         assert found is not None
@@ -131,10 +143,11 @@ def test_a_zero_where_the_pattern_has_an_entry_is_given_up():
     assert solver.solve(q, a, b) is None
 
 
-def test_only_cone_rows_of_one_entry_each_one_per_variable_fit():
+def test_cone_rows_of_at_most_one_entry_that_reach_every_variable_fit():
     identity = np.vstack([np.ones((2, 3)), -np.eye(3)])
     assert ConeInteriorPoint.fits(2, identity)
     assert ConeInteriorPoint.fits(2, identity[[0, 1, 3, 4, 2]])  # (rows of the cones permuted)
+    assert ConeInteriorPoint.fits(2, np.vstack([identity, np.zeros(3), [0.0, 2.0, 0.0]]))
     two_in_a_row = identity.copy()
     two_in_a_row[2, 1] = 1.0
     assert not ConeInteriorPoint.fits(2, two_in_a_row)

@@ -5,13 +5,16 @@ With ellipsoid or cone models, the planner's programs are, in Clarabel's form,
 .. math:: \min q^T x \quad\text{s.t.}\quad A_E x = b_E,\quad h - G x \in K
           = \mathbb{R}_+^{l} \times \mathcal{Q}^{d_1} \times \dots
 
-where every row of ``G`` holds one entry and every variable one row: each variable is a
-scaled coordinate of one cone (a normal force, a friction force, a moment). In the cone
-coordinates ``s = h - G x`` the program is in standard form,
-``min c^T s`` s.t. ``F s = f``, ``s`` in ``K``, with ``p`` (six per load case) equality rows.
-Its primal-dual interior-point method needs one ``p x p`` system per step,
-``F W^2 F^T`` (``W`` the Nesterov-Todd scaling), where Clarabel factorises the whole KKT
-system: about 8 of its iterations of 20 µs each for one 8-contact case.
+where every row of ``G`` holds at most one entry and every variable at least one: each
+variable is a scaled coordinate of a cone (a normal force, a friction force, a moment, a load
+multiple and its bounds), and a row without one is a constant coordinate (a given normal
+force). In the cone coordinates ``s = h - G x`` the program is in standard form,
+``min c^T s`` s.t. ``F s = f``, ``s`` in ``K``: the rows of ``A_E`` in ``s`` (each variable
+through its first row), plus ``s_r = h_r`` for a constant row and the link between the first
+row of a variable and each further one. Its primal-dual interior-point method needs one
+``p x p`` system per step, ``F W^2 F^T`` (``W`` the Nesterov-Todd scaling; ``p`` is six per load
+case and one per such extra row), where Clarabel factorises the whole KKT system: about 8 of
+its iterations of 20 µs each for one 8-contact case.
 
 The method is the infeasible-start path-following method with Mehrotra's predictor and
 corrector (as in CVXOPT's ``coneqp`` and SDPT3), compiled in one call. Small pivots of the
@@ -45,8 +48,9 @@ PIVOT_RTOL, HUGE_PIVOT = 1e-30, 1e128
 class ConeInteriorPoint:
     """Solves ``min q'x`` s.t. ``A x + s = b``, ``s`` in ``equalities`` zero rows,
     ``nonnegative`` rows and second-order cones of ``dimensions``, for ``A`` (dense, nonzero
-    where ``pattern`` is) whose cone rows hold one entry each, one per variable (:meth:`fits`).
-    ``settings`` may set :data:`TOLERANCES` (other Clarabel settings are ignored)."""
+    only where ``pattern`` is) whose cone rows hold at most one entry each and every variable
+    at least one (:meth:`fits`). ``settings`` may set :data:`TOLERANCES` (other Clarabel
+    settings are ignored)."""
 
     def __init__(
         self,
@@ -61,21 +65,20 @@ class ConeInteriorPoint:
         self._zero = int(equalities)
         self._nonneg = int(nonnegative)
         self._dimensions = np.asarray(dimensions, dtype=np.int64).reshape(-1)
-        #: The variable of each cone row.
-        self._variable = np.argmax(pattern[self._zero :] != 0.0, axis=1).astype(np.int64)
+        cone = np.asarray(pattern)[self._zero :] != 0.0
+        #: The variable of each cone row (-1: a constant row), and the first row of each
+        #: variable (whose coordinate stands for it).
+        self._variable = np.where(cone.any(axis=1), cone.argmax(axis=1), -1).astype(np.int64)
+        self._first_row = cone.argmax(axis=0).astype(np.int64)
         #: Iterations of the last solve.
         self.iterations = 0
 
     @staticmethod
     def fits(equalities: int, pattern: np.ndarray) -> bool:
-        """Whether the cone rows of ``pattern`` (``A`` or its nonzero pattern) hold one entry
-        each and every variable one such entry."""
+        """Whether the cone rows of ``pattern`` (``A`` or its nonzero pattern) hold at most
+        one entry each and every variable at least one."""
         cone = np.asarray(pattern)[equalities:] != 0.0
-        return (
-            cone.shape[0] == cone.shape[1]
-            and bool(np.all(cone.sum(axis=1) == 1))
-            and bool(np.all(cone.sum(axis=0) == 1))
-        )
+        return bool(np.all(cone.sum(axis=1) <= 1)) and bool(np.all(cone.any(axis=0)))
 
     def solve(
         self, q: np.ndarray, a: np.ndarray, b: np.ndarray
@@ -85,18 +88,19 @@ class ConeInteriorPoint:
         rows, n = a.shape
         x, z = np.empty(n), np.empty(rows)
         status, self.iterations = _SOLVE(
-            q, a, b, self._zero, self._nonneg, self._dimensions, self._variable, x, z,
-            *self._tolerances, MAX_ITERATIONS, STEP_FRACTION,
+            q, a, b, self._zero, self._nonneg, self._dimensions, self._variable,
+            self._first_row, x, z, *self._tolerances, MAX_ITERATIONS, STEP_FRACTION,
         )  # fmt: skip
         return (x, z) if status == 0 else None
 
 
 def solve_standard_form(
-    q, a, b, zero, nonneg, dimensions, variable, x_out, z_out,
+    q, a, b, zero, nonneg, dimensions, variable, first_row, x_out, z_out,
     tol_feas, tol_gap_abs, tol_gap_rel, max_iterations, step_fraction,
 ):  # fmt: skip  # pragma: no cover - compiled
     """Write the optimum of Clarabel's program into ``x_out`` and ``z_out``; ``(0,
     iterations)`` when solved, else ``(1, iterations)``."""
+    n = a.shape[1]
     m = a.shape[0] - zero
     blocks = nonneg + dimensions.shape[0]
     start = np.empty(blocks, dtype=np.int64)
@@ -106,35 +110,53 @@ def solve_standard_form(
         start[k] = row
         size[k] = 1 if k < nonneg else dimensions[k - nonneg]
         row += size[k]
-    # Standard form in s = h - G x: x_j = (h_r - s_r) / g_r for the row r of variable j, so
-    # A_E x = b_E is F s = f with F[:, r] = -A_E[:, j] / g_r, f = b_E - sum_r A_E[:, j] h_r / g_r,
-    # and q'x = c's + constant with c_r = -q_j / g_r.
-    f_matrix = np.empty((zero, m))
-    f = b[:zero].copy()
-    c = np.empty(m)
+    # In s = h - G x, variable j is x_j = (h_r - s_r) / g_r of its first row r. So the rows of
+    # A_E x = b_E are F s = f with F[:, r] = -A_E[:, j] / g_r, f = b_E - sum_j A_E[:, j] h_r / g_r;
+    # q'x = c's + constant with c_r = -q_j / g_r; a further row t of variable j is
+    # s_t - (g_t / g_r) s_r = h_t - g_t h_r / g_r, and a constant row t is s_t = h_t.
     gain = np.empty(m)
-    for r in range(m):
-        j = variable[r]
-        g = a[zero + r, j]
-        if g == 0.0:  # (a parametric entry of the pattern that is 0 now)
+    for t in range(m):
+        gain[t] = a[zero + t, variable[t]] if variable[t] >= 0 else 1.0
+        if gain[t] == 0.0:  # (an entry of the pattern that is 0 now)
             return 1, 0
+    p = zero + m - n
+    f_matrix = np.zeros((p, m))
+    f = np.zeros(p)
+    c = np.zeros(m)
+    for e in range(zero):
+        f[e] = b[e]
+    for j in range(n):
+        r = first_row[j]
         h = b[zero + r]
-        gain[r] = g
-        c[r] = -q[j] / g
+        c[r] = -q[j] / gain[r]
         for e in range(zero):
-            f_matrix[e, r] = -a[e, j] / g
-            f[e] -= a[e, j] * h / g
+            f_matrix[e, r] = -a[e, j] / gain[r]
+            f[e] -= a[e, j] * h / gain[r]
+    link = zero
+    for t in range(m):
+        j = variable[t]
+        if j >= 0 and first_row[j] == t:
+            continue
+        f_matrix[link, t] = 1.0
+        f[link] = b[zero + t]
+        if j >= 0:
+            r = first_row[j]
+            f_matrix[link, r] = -gain[t] / gain[r]
+            f[link] -= gain[t] * b[zero + r] / gain[r]
+        link += 1
     s = np.empty(m)
-    y = np.empty(zero)
+    y = np.empty(p)
     z = np.empty(m)
     status, iterations = _STANDARD(f_matrix, f, c, start, size, nonneg, s, y, z, tol_feas,
                                    tol_gap_abs, tol_gap_rel, max_iterations, step_fraction)  # fmt: skip
     if status != 0:
         return status, iterations
     # Back: x from s; Clarabel's multipliers are -y on the equalities and z on the cones.
-    for r in range(m):
-        x_out[variable[r]] = (b[zero + r] - s[r]) / gain[r]
-        z_out[zero + r] = z[r]
+    for j in range(n):
+        r = first_row[j]
+        x_out[j] = (b[zero + r] - s[r]) / gain[r]
+    for t in range(m):
+        z_out[zero + t] = z[t]
     for e in range(zero):
         z_out[e] = -y[e]
     return 0, iterations
