@@ -23,7 +23,10 @@ states it at every step of the path, to three solvers in the same run, each warm
 solve: fixplan's dual simplex (:mod:`fixplan.planner.dual_simplex`), HiGHS through ``highspy``
 (the model passed once, the row bounds changed, its simplex hot-started from the kept basis)
 and Clarabel (``b`` updated in place; an interior point has no warm start). Their optima must
-agree to 1e-6 (relative to the optimum, at least 1).
+agree to 1e-6 (relative to the optimum, at least 1). So is the ellipsoid grasp's cone program
+(``A x = b`` on the equilibrium rows, second-order cones on the rest; again only ``b``
+changes), handed to fixplan's compiled interior-point method
+(:mod:`fixplan.planner.cone_interior_point`) and to Clarabel.
 
 The machine's load average is printed with the figures (other processes slow these
 single-threaded runs).
@@ -120,12 +123,39 @@ def main() -> None:
 
     exact_row(path[: max(count // 20, 10)], medians["ellipsoid"])
     linear_program_row(path)
+    cone_program_row(path)
 
 
 def linear_program_row(path: list) -> None:
     """The pyramid grasp's linear program at every step of ``path``, solved by the dual
     simplex, HiGHS and Clarabel, each warm from its last solve (see the module)."""
-    problem = fixture("pyramid", "min-total-clamp-force", path[0])
+    direct, q, matrix, steps = _program_steps("pyramid", path)
+    equalities = direct._simplex._equalities
+    solvers = {
+        "dual simplex": _simplex_steps(matrix, q, equalities),
+        "HiGHS (hot start)": _highs_steps(matrix, q, equalities),
+        "Clarabel": _clarabel_steps(matrix, q, equalities),
+    }
+    _compare_solvers("pyramid", "linear program", q, matrix, steps, solvers)
+
+
+def cone_program_row(path: list) -> None:
+    """The ellipsoid grasp's cone program at every step of ``path``, solved by the compiled
+    interior-point method and by Clarabel (``b`` updated in place; see the module)."""
+    direct, q, matrix, steps = _program_steps("ellipsoid", path)
+    interior = direct._interior
+    cones = (interior._zero, interior._nonneg, interior._dimensions)
+    solvers = {
+        "interior point": lambda b: interior.solve(q, matrix, b)[0],
+        "Clarabel": _clarabel_steps(matrix, q, *cones),
+    }
+    _compare_solvers("ellipsoid", "cone program", q, matrix, steps, solvers)
+
+
+def _program_steps(model: str, path: list) -> tuple:
+    """The direct solver of ``model``'s grasp, its cost, constraint matrix (dense) and the
+    ``b`` of every step of ``path``, as the planner states them (only ``b`` changes)."""
+    problem = fixture(model, "min-total-clamp-force", path[0])
     planner = Planner(problem)
     for warm in path[:3]:
         planner.solve(warm, analyse=False)
@@ -138,12 +168,13 @@ def linear_program_row(path: list) -> None:
         q, _ = program.cost(vector)
         a, b = program.constraints(vector)
         steps.append(b)
-    matrix, equalities = program.dense(a), direct._simplex._equalities
-    solvers = {
-        "dual simplex": _simplex_steps(matrix, q, equalities),
-        "HiGHS (hot start)": _highs_steps(matrix, q, equalities),
-        "Clarabel": _clarabel_steps(matrix, q, equalities),
-    }
+    return direct, q, program.dense(a), steps
+
+
+def _compare_solvers(grasp: str, kind: str, q, matrix, steps, solvers: dict) -> None:
+    """Time each of ``solvers`` (``b -> x``, the first fixplan's) on every ``b`` of ``steps``
+    of the ``grasp``'s program, after a cold first solve; their optima must agree to 1e-6
+    (relative, at least 1)."""
     times, optima = {}, {}
     for name, step in solvers.items():
         step(steps[0])  # first solve: cold
@@ -154,27 +185,27 @@ def linear_program_row(path: list) -> None:
             x = step(b)
             times[name][k] = time.perf_counter() - start
             optima[name][k] = q @ x
+    ours, *others = solvers
     scale = np.maximum(np.abs(optima["Clarabel"]), 1.0)
     disagreement = {
-        name: float(np.max(np.abs(values - optima["dual simplex"]) / scale))
-        for name, values in optima.items()
+        name: float(np.max(np.abs(optima[name] - optima[ours]) / scale)) for name in others
     }
     assert max(disagreement.values()) <= 1e-6, disagreement
-    ours = np.median(times["dual simplex"])
-    print(f"linear program of the pyramid grasp ({matrix.shape[0]} rows, {matrix.shape[1]} "
-          f"variables), {len(steps):,} right-hand sides; largest relative difference of the "
-          f"optima from the dual simplex's: HiGHS {disagreement['HiGHS (hot start)']:.1e}, "
-          f"Clarabel {disagreement['Clarabel']:.1e}")  # fmt: skip
+    differences = ", ".join(f"{name} {value:.1e}" for name, value in disagreement.items())
+    print(f"{kind} of the {grasp} grasp ({matrix.shape[0]} rows, {matrix.shape[1]} variables), {len(steps):,} "
+          f"right-hand sides; largest relative difference of the optima from the {ours}'s: "
+          f"{differences}")  # fmt: skip
+    median = np.median(times[ours])
     for name, measured in times.items():
-        print(f"  {name:18s} {figures(measured)}; / dual simplex {np.median(measured) / ours:5.1f}")
+        print(f"  {name:18s} {figures(measured)}; / {ours} {np.median(measured) / median:5.1f}")
     emit(
-        f"the pyramid grasp's linear program alone ({matrix.shape[0]} rows × {matrix.shape[1]} "
-        f"variables), {len(steps):,} right-hand sides (median, p99): fixplan's dual simplex",
-        figures(times["dual simplex"]),
-        "; ".join(f"{name} {figures(times[name])}" for name in ("HiGHS (hot start)", "Clarabel")),
-        "; ".join(f"{np.median(times[name]) / ours:.1f}× slower"
-                  for name in ("HiGHS (hot start)", "Clarabel")),
-    )  # fmt: skip
+        f"the {grasp} grasp's {kind} alone ({matrix.shape[0]} rows × "
+        f"{matrix.shape[1]} variables), {len(steps):,} right-hand sides (median, p99): "
+        f"fixplan's {ours}",
+        figures(times[ours]),
+        "; ".join(f"{name} {figures(times[name])}" for name in others),
+        "; ".join(f"{np.median(times[name]) / median:.1f}× slower" for name in others),
+    )
 
 
 def _simplex_steps(matrix, q, equalities):
@@ -211,14 +242,18 @@ def _highs_steps(matrix, q, equalities):
     return step
 
 
-def _clarabel_steps(matrix, q, equalities):
-    """Clarabel with the planner's settings; each step updates ``b`` in place."""
+def _clarabel_steps(matrix, q, equalities, nonneg=None, dimensions=()):
+    """Clarabel with the planner's settings; each step updates ``b`` in place. The rows after
+    the ``equalities`` are ``nonneg`` nonnegative ones (default: all) and then second-order
+    cones of ``dimensions``."""
     options = clarabel.DefaultSettings()
     options.verbose, options.presolve_enable = False, False
     for key, value in _SOLVER_OPTIONS["CLARABEL"].items():
         setattr(options, key, value)
     rows, columns = matrix.shape
-    cones = [clarabel.ZeroConeT(equalities), clarabel.NonnegativeConeT(rows - equalities)]
+    nonneg = rows - equalities if nonneg is None else nonneg
+    cones = [clarabel.ZeroConeT(equalities), clarabel.NonnegativeConeT(nonneg)]
+    cones += [clarabel.SecondOrderConeT(int(d)) for d in dimensions]
     zero = sp.csc_matrix((columns, columns))
     solver = clarabel.DefaultSolver(zero, q, sp.csc_matrix(matrix), np.zeros(rows), cones, options)
 
