@@ -26,7 +26,8 @@ and Clarabel (``b`` updated in place; an interior point has no warm start). Thei
 agree to 1e-6 (relative to the optimum, at least 1). So is the ellipsoid grasp's cone program
 (``A x = b`` on the equilibrium rows, second-order cones on the rest; again only ``b``
 changes), handed to fixplan's compiled interior-point method
-(:mod:`fixplan.planner.cone_interior_point`) and to Clarabel.
+(:mod:`fixplan.planner.cone_interior_point`, which starts from its last optimum) and to
+Clarabel.
 
 The machine's load average is printed with the figures (other processes slow these
 single-threaded runs).
