@@ -118,12 +118,12 @@ def test_a_solve_starts_from_the_last_optimum_of_its_cost():
         _assert_optimal(solver.solve(q, a, moved), q, a, moved, *cones)
         warm.append(solver.iterations)
     assert max(warm) < cold, (warm, cold)
-    jumped = b.copy()
-    jumped[:6] += a[:6] @ direction
-    _assert_optimal(solver.solve(q, a, jumped), q, a, jumped, *cones)
     _assert_optimal(solver.solve(2.0 * q, a, b), 2.0 * q, a, b, *cones)  # (from its own start)
     _assert_optimal(solver.solve(q, a, moved), q, a, moved, *cones)
     assert solver.iterations < cold  # (q's optimum kept beside 2q's)
+    jumped = b.copy()
+    jumped[:6] += a[:6] @ direction
+    _assert_optimal(solver.solve(q, a, jumped), q, a, jumped, *cones)
 
 
 def _assert_optimal(found, q, a, b, equalities, nonneg, dimensions):

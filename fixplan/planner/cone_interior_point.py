@@ -23,7 +23,9 @@ Cholesky factorisation for interior-point methods: that direction is dropped), a
 grows ill-conditioned near the optimum. Its stopping rule is Clarabel's: residuals and
 duality gap below ``TOL_FEAS`` and ``TOL_GAP_*`` of the data's size.
 
-It finds optima only: where the program looks infeasible or unbounded, or the method makes no
+A solve starts from the last optimum of the same cost, moved into the cones' interior: the
+loads of a control loop change little between solves, and such starts save a third of the
+iterations. It finds optima only: where the program looks infeasible or unbounded, or the method makes no
 progress (``MAX_ITERATIONS``, a tiny step), it gives up and the caller asks Clarabel, which
 also returns the certificates.
 """
@@ -37,15 +39,16 @@ from fixplan.surface.point_kernel import compiled_scalar
 #: Stopping tolerances by Clarabel's names, and its defaults: primal and dual residuals
 #: relative to the data's size, and the duality gap absolute and relative to the objective.
 TOLERANCES = {"tol_feas": 1e-8, "tol_gap_abs": 1e-8, "tol_gap_rel": 1e-8}
-#: Iterations before the method gives up (the planner's programs take about 10).
+#: Iterations before the method gives up (the planner's re-solves take 5-7).
 MAX_ITERATIONS = 50
 #: Fraction of the largest step to the cones' boundary taken.
 STEP_FRACTION = 0.99
 #: A solve starts from the last optimum of the same cost (a control loop's loads change
 #: little), each cone's part moved inside by this fraction of its largest entry; from
-#: Mehrotra's start where that fails. (On ``bench_realtime.py``'s path: 6.0 iterations against
-#: 9.3; shifts from 1e-3 to 1 gave 5.9-6.9.)
-WARM_SHIFT = 1e-2
+#: Mehrotra's start where that fails. (Along ``bench_realtime.py``'s path, bare re-solves and
+#: analysis programs: 5.7 iterations from the last optimum against 9.4 and 10.9 from
+#: Mehrotra's start; shifts of 1e-4, 1e-2 and 1 gave 5.4, 5.8-6.7 and 9.3.)
+WARM_SHIFT = 1e-3
 #: A Cholesky pivot below this fraction of its diagonal entry is replaced by ``HUGE_PIVOT``.
 PIVOT_RTOL, HUGE_PIVOT = 1e-30, 1e128
 
