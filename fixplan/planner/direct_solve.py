@@ -39,7 +39,9 @@ SIMPLEX_MAX_ENTRIES = 100_000
 SIMPLEX_MAX_CHANGING_VARIABLES = 64
 
 #: Cone programs up to this many constraint-matrix entries go to the compiled interior-point
-#: method where they fit it (one 8-contact case with ellipsoid models has 38 x 32).
+#: method where they fit it: its dense steps grow faster than Clarabel's sparse ones. (Against
+#: Clarabel on the 8-contact fixture with ellipsoid models: 0.39 of its time at 1 load case,
+#: 38 x 32 entries; 0.81 at 4 cases, 152 x 122; 1.18 at 6 cases, 228 x 182.)
 INTERIOR_MAX_ENTRIES = 20_000
 
 #: What :meth:`DirectSolver.gather` reads at position -1.
