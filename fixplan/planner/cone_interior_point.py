@@ -23,9 +23,9 @@ Cholesky factorisation for interior-point methods: that direction is dropped), a
 grows ill-conditioned near the optimum. Its stopping rule is Clarabel's: residuals and
 duality gap below ``TOL_FEAS`` and ``TOL_GAP_*`` of the data's size.
 
-A solve starts from the last optimum of the same cost, moved into the cones' interior: the
-loads of a control loop change little between solves, and such starts save a third of the
-iterations. It finds optima only: where the program looks infeasible or unbounded, or the method makes no
+A solve starts from the last optimum of the same cost, moved into the cones' interior as far
+as the loads moved: those of a control loop change little between solves, and such starts save
+a third of the iterations. It finds optima only: where the program looks infeasible or unbounded, or the method makes no
 progress (``MAX_ITERATIONS``, a tiny step), it gives up and the caller asks Clarabel, which
 also returns the certificates.
 """
@@ -43,12 +43,15 @@ TOLERANCES = {"tol_feas": 1e-8, "tol_gap_abs": 1e-8, "tol_gap_rel": 1e-8}
 MAX_ITERATIONS = 50
 #: Fraction of the largest step to the cones' boundary taken.
 STEP_FRACTION = 0.99
-#: A solve starts from the last optimum of the same cost (a control loop's loads change
-#: little), each cone's part moved inside by this fraction of its largest entry; from
-#: Mehrotra's start where that fails. (Along ``bench_realtime.py``'s path, bare re-solves and
-#: analysis programs: 5.7 iterations from the last optimum against 9.4 and 10.9 from
-#: Mehrotra's start; shifts of 1e-4, 1e-2 and 1 gave 5.4, 5.8-6.7 and 9.3.)
-WARM_SHIFT = 1e-3
+#: A solve starts from the last optimum of the same cost, each cone's part moved inside by a
+#: fraction of its largest entry: the relative residual of ``F s = f`` at that optimum (how far
+#: the loads moved), clipped to ``[WARM_SHIFT, SHIFT_MAX]``; from Mehrotra's start where that
+#: fails. Along ``bench_realtime.py``'s path (loads that change little) the bare re-solves and
+#: the analysis programs took 5.8 and 5.9 iterations, against 9.4 and 10.9 from Mehrotra's
+#: start; with loads drawn at random (``bench_planner.milling_loads``) the grasp's bare re-solve
+#: took 521 µs against 588 µs with Clarabel (a fixed shift of 1e-3: 676 µs, of 1e-1: 543 µs,
+#: and 6.7 and 8.6 iterations along the path).
+WARM_SHIFT, SHIFT_MAX = 1e-3, 1e-1
 #: A Cholesky pivot below this fraction of its diagonal entry is replaced by ``HUGE_PIVOT``.
 PIVOT_RTOL, HUGE_PIVOT = 1e-30, 1e128
 
@@ -106,7 +109,7 @@ class ConeInteriorPoint:
             status, self.iterations = _SOLVE(
                 q, a, b, self._zero, self._nonneg, self._dimensions, self._variable,
                 self._first_row, x, z, *start, warm, *self._tolerances, MAX_ITERATIONS,
-                STEP_FRACTION, WARM_SHIFT,
+                STEP_FRACTION, WARM_SHIFT, SHIFT_MAX,
             )  # fmt: skip
             if status == 0:
                 if len(self._optima) >= 8:
@@ -118,7 +121,7 @@ class ConeInteriorPoint:
 
 def solve_standard_form(
     q, a, b, zero, nonneg, dimensions, variable, first_row, x_out, z_out, s, y, z, warm,
-    tol_feas, tol_gap_abs, tol_gap_rel, max_iterations, step_fraction, warm_shift,
+    tol_feas, tol_gap_abs, tol_gap_rel, max_iterations, step_fraction, warm_shift, shift_max,
 ):  # fmt: skip  # pragma: no cover - compiled
     """Write the optimum of Clarabel's program into ``x_out`` and ``z_out``, and that of its
     standard form into ``s``, ``y`` and ``z`` (with ``warm``, the start); ``(0, iterations)``
@@ -169,7 +172,7 @@ def solve_standard_form(
         link += 1
     status, iterations = _STANDARD(f_matrix, f, c, start, size, nonneg, s, y, z, warm, tol_feas,
                                    tol_gap_abs, tol_gap_rel, max_iterations, step_fraction,
-                                   warm_shift)  # fmt: skip
+                                   warm_shift, shift_max)  # fmt: skip
     if status != 0:
         return status, iterations
     # Back: x from s; Clarabel's multipliers are -y on the equalities and z on the cones.
@@ -185,20 +188,28 @@ def solve_standard_form(
 
 def standard_form(
     f_matrix, f, c, start, size, nonneg, x, y, z, warm,
-    tol_feas, tol_gap_abs, tol_gap_rel, max_iterations, step_fraction, warm_shift,
+    tol_feas, tol_gap_abs, tol_gap_rel, max_iterations, step_fraction, warm_shift, shift_max,
 ):  # fmt: skip  # pragma: no cover - compiled
     """``min c'x`` s.t. ``F x = f``, ``x`` in the cones (dual: ``max f'y`` s.t.
     ``F'y + z = c``, ``z`` in the cones): the optimum into ``x``, ``y``, ``z``; ``(0,
     iterations)`` when solved, else ``(1, iterations)``. With ``warm``, from the ``x``, ``y``
-    and ``z`` given, each cone's part moved inside by ``warm_shift`` of the largest entry."""
+    and ``z`` given, each cone's part moved inside by a fraction of the largest entry: the
+    relative residual of ``F x = f`` there, clipped to ``[warm_shift, shift_max]``."""
     p, m = f_matrix.shape
     blocks = start.shape[0]
     degree = float(blocks)
     normal = np.empty((p, p))  # F W^2 F'
     chol = np.empty((p, p))
     if warm:
-        shift_x = warm_shift * max(_largest(x), 1e-12)
-        shift_z = warm_shift * max(_largest(z), 1e-12)
+        moved = 0.0  # how far the last optimum is from F x = f now
+        for i in range(p):
+            total = f[i]
+            for r in range(m):
+                total -= f_matrix[i, r] * x[r]
+            moved = max(moved, abs(total))
+        fraction = min(max(moved / max(_largest(f), 1e-300), warm_shift), shift_max)
+        shift_x = fraction * max(_largest(x), 1e-12)
+        shift_z = fraction * max(_largest(z), 1e-12)
         for k in range(blocks):
             x[start[k]] += shift_x
             z[start[k]] += shift_z

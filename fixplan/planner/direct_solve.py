@@ -40,9 +40,10 @@ SIMPLEX_MAX_CHANGING_VARIABLES = 64
 
 #: Cone programs up to this many constraint-matrix entries go to the compiled interior-point
 #: method where they fit it: its dense steps grow faster than Clarabel's sparse ones. (Against
-#: Clarabel on the 8-contact fixture with ellipsoid models: 0.39 of its time at 1 load case,
-#: 38 x 32 entries; 0.81 at 4 cases, 152 x 122; 1.18 at 6 cases, 228 x 182.)
-INTERIOR_MAX_ENTRIES = 20_000
+#: Clarabel on the 8-contact fixture with ellipsoid models, from Mehrotra's start and from the
+#: last optimum of similar loads: 0.71 and 0.39 of its time at 1 load case, 38 x 32 entries;
+#: 1.08 and 0.46 at 2 cases, 76 x 62; 1.47 and 0.60 at 3 cases, 114 x 92.)
+INTERIOR_MAX_ENTRIES = 2_500
 
 #: What :meth:`DirectSolver.gather` reads at position -1.
 _ZERO = np.zeros(1)
