@@ -49,7 +49,7 @@ STEP_FRACTION = 0.99
 #: fails. Along ``bench_realtime.py``'s path (loads that change little) the bare re-solves and
 #: the analysis programs took 5.8 and 5.9 iterations, against 9.4 and 10.9 from Mehrotra's
 #: start; with loads drawn at random (``bench_planner.milling_loads``) the grasp's bare re-solve
-#: took 521 µs against 588 µs with Clarabel (a fixed shift of 1e-3: 676 µs, of 1e-1: 543 µs,
+#: took 521–539 µs against 588 µs with Clarabel (a fixed shift of 1e-3: 676 µs, of 1e-1: 543 µs,
 #: and 6.7 and 8.6 iterations along the path).
 WARM_SHIFT, SHIFT_MAX = 1e-3, 1e-1
 #: A Cholesky pivot below this fraction of its diagonal entry is replaced by ``HUGE_PIVOT``.
