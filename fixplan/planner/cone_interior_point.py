@@ -230,16 +230,10 @@ def standard_form(
     target = np.empty(m)
     work = np.empty(m)
     for iteration in range(max_iterations):
-        for i in range(p):
-            total = f[i]
-            for r in range(m):
-                total -= f_matrix[i, r] * x[r]
-            r_p[i] = total
+        _product(f_matrix, x, f, -1.0, r_p)
+        _transposed_product(f_matrix, y, c, -1.0, r_d)
         for r in range(m):
-            total = c[r] - z[r]
-            for i in range(p):
-                total -= f_matrix[i, r] * y[i]
-            r_d[r] = total
+            r_d[r] -= z[r]
         primal, dual, gap = 0.0, 0.0, 0.0
         for r in range(m):
             primal += c[r] * x[r]
@@ -259,13 +253,7 @@ def standard_form(
             for r in range(m):
                 scaled[i, r] = f_matrix[i, r]
             _apply_scaling(scaled[i], start, size, nonneg, beta, v, False)
-        for i in range(p):
-            for k in range(i + 1):
-                total = 0.0
-                for r in range(m):
-                    total += scaled[i, r] * scaled[k, r]
-                normal[i, k] = total
-                normal[k, i] = total
+        _gram(scaled, normal)
         _modified_cholesky(normal, chol)
         # Predictor: lambda o (W^-1 dx + W dz) = -lambda o lambda, lambda \ d = -lambda.
         for r in range(m):
@@ -307,32 +295,14 @@ def _mehrotra_start(
     """Mehrotra's start: ``x = F'(FF')^-1 f``, ``y = (FF')^-1 F c``, ``z = c - F'y``, both
     moved into their cones (``normal`` and ``chol``: work arrays ``p x p``)."""
     p, m = f_matrix.shape
-    for i in range(p):
-        for k in range(i + 1):
-            total = 0.0
-            for r in range(m):
-                total += f_matrix[i, r] * f_matrix[k, r]
-            normal[i, k] = total
-            normal[k, i] = total
+    _gram(f_matrix, normal)
     _modified_cholesky(normal, chol)
     t = f.copy()
     _cholesky_solve(chol, t)
-    for r in range(m):
-        total = 0.0
-        for i in range(p):
-            total += f_matrix[i, r] * t[i]
-        x[r] = total
-    for i in range(p):
-        total = 0.0
-        for r in range(m):
-            total += f_matrix[i, r] * c[r]
-        y[i] = total
+    _transposed_product(f_matrix, t, np.zeros(m), 1.0, x)
+    _product(f_matrix, c, np.zeros(p), 1.0, y)
     _cholesky_solve(chol, y)
-    for r in range(m):
-        total = c[r]
-        for i in range(p):
-            total -= f_matrix[i, r] * y[i]
-        z[r] = total
+    _transposed_product(f_matrix, y, c, -1.0, z)
     _into_cones(x, start, size, nonneg)
     _into_cones(z, start, size, nonneg)
 
@@ -342,29 +312,51 @@ def _direction(f_matrix, chol, start, size, nonneg, beta, v, r_p, r_d, jordan, d
     """The Newton direction of ``F dx = r_p``, ``F'dy + dz = r_d`` and ``W^-1 dx + W dz =
     jordan``: ``F W^2 F' dy = r_p - F W jordan + F W^2 r_d``, ``dz = r_d - F'dy``,
     ``dx = W (jordan - W dz)``."""
-    p, m = f_matrix.shape
+    m = f_matrix.shape[1]
     for r in range(m):  # W^2 r_d - W jordan = W (W r_d - jordan)
         work[r] = r_d[r]
     _apply_scaling(work, start, size, nonneg, beta, v, False)
     for r in range(m):
         work[r] -= jordan[r]
     _apply_scaling(work, start, size, nonneg, beta, v, False)
-    for i in range(p):
-        total = r_p[i]
-        for r in range(m):
-            total += f_matrix[i, r] * work[r]
-        dy[i] = total
+    _product(f_matrix, work, r_p, 1.0, dy)
     _cholesky_solve(chol, dy)
+    _transposed_product(f_matrix, dy, r_d, -1.0, dz)
     for r in range(m):
-        total = r_d[r]
-        for i in range(p):
-            total -= f_matrix[i, r] * dy[i]
-        dz[r] = total
-        dx[r] = total
+        dx[r] = dz[r]
     _apply_scaling(dx, start, size, nonneg, beta, v, False)
     for r in range(m):
         dx[r] = jordan[r] - dx[r]
     _apply_scaling(dx, start, size, nonneg, beta, v, False)
+
+
+def _product(f_matrix, v, base, sign, out):  # pragma: no cover - compiled
+    """``out = base + sign F v``."""
+    for i in range(f_matrix.shape[0]):
+        total = 0.0
+        for r in range(f_matrix.shape[1]):
+            total += f_matrix[i, r] * v[r]
+        out[i] = base[i] + sign * total
+
+
+def _transposed_product(f_matrix, v, base, sign, out):  # pragma: no cover - compiled
+    """``out = base + sign F' v``."""
+    for r in range(f_matrix.shape[1]):
+        total = 0.0
+        for i in range(f_matrix.shape[0]):
+            total += f_matrix[i, r] * v[i]
+        out[r] = base[r] + sign * total
+
+
+def _gram(rows, out):  # pragma: no cover - compiled
+    """``out = rows rows'``."""
+    for i in range(rows.shape[0]):
+        for k in range(i + 1):
+            total = 0.0
+            for r in range(rows.shape[1]):
+                total += rows[i, r] * rows[k, r]
+            out[i, k] = total
+            out[k, i] = total
 
 
 def _modified_cholesky(matrix, out):  # pragma: no cover - compiled
@@ -563,6 +555,9 @@ _apply_scaling = compiled_scalar(_apply_scaling)
 _jordan_product = compiled_scalar(_jordan_product)
 _jordan_solve = compiled_scalar(_jordan_solve)
 _step = compiled_scalar(_step)
+_product = compiled_scalar(_product)
+_transposed_product = compiled_scalar(_transposed_product)
+_gram = compiled_scalar(_gram)
 _modified_cholesky = compiled_scalar(_modified_cholesky)
 _cholesky_solve = compiled_scalar(_cholesky_solve)
 _mehrotra_start = compiled_scalar(_mehrotra_start)
