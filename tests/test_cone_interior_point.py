@@ -149,11 +149,14 @@ def _assert_optimal(found, q, a, b, equalities, nonneg, dimensions):
 
 def test_an_infeasible_program_is_given_up():
     """``x >= 1`` (``s = -1 + x``) and ``x <= 0`` through the equality ``x + t = 0`` with
-    ``t >= 0``: no point; the caller then asks Clarabel for the certificate."""
+    ``t >= 0``: no point; the caller then asks Clarabel for the certificate. The iterates run
+    off along the ray of the certificate, and the method stops there."""
     q = np.array([1.0, 0.0])
     a = np.array([[1.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
     b = np.array([0.0, -1.0, 0.0])
-    assert ConeInteriorPoint(1, 2, [], a).solve(q, a, b) is None
+    solver = ConeInteriorPoint(1, 2, [], a)
+    assert solver.solve(q, a, b) is None
+    assert solver.iterations < 10  # (stopped at the ray, not at MAX_ITERATIONS)
 
 
 def test_an_unbounded_program_is_given_up():
@@ -161,7 +164,9 @@ def test_an_unbounded_program_is_given_up():
     q = np.array([-1.0, 0.0])
     a = np.array([[1.0, -1.0], [-1.0, 0.0], [0.0, -1.0]])
     b = np.zeros(3)
-    assert ConeInteriorPoint(1, 2, [], a).solve(q, a, b) is None
+    solver = ConeInteriorPoint(1, 2, [], a)
+    assert solver.solve(q, a, b) is None
+    assert solver.iterations < 10
 
 
 def test_a_zero_where_the_pattern_has_an_entry_is_given_up():

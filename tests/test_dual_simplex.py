@@ -89,6 +89,31 @@ def test_infeasible_and_unbounded_programs_give_none():
     assert DualSimplex(0).solve(below, np.array([1.0]), np.array([1.0])) is None
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_a_warm_start_that_finds_the_program_infeasible_gives_up_without_an_artificial_start(
+    seed, monkeypatch
+):
+    """Box rows crossed (``x_0 <= -l - 1`` and ``x_0 >= -l``): the pivots from the last basis
+    end on a dual ray, and the solve gives up at once; the next right-hand side starts from
+    the basis kept before."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(3, 30))
+    equalities = int(rng.integers(0, min(n, 7)))
+    inequalities = int(rng.integers(n, 4 * n))
+    a, q, right_hand_side = _random_program(rng, n, equalities, inequalities)
+    simplex = DualSimplex(equalities)
+    assert simplex.solve(a, q, right_hand_side(0.0)) is not None
+    monkeypatch.setattr(DualSimplex, "_cold", lambda *args: pytest.fail("an artificial start"))
+    crossed = right_hand_side(0.1)
+    upper = equalities + inequalities
+    crossed[upper] = -crossed[upper + n] - 1.0
+    assert _highs(a, crossed, q, equalities).status == 2  # (infeasible)
+    assert simplex.solve(a, q, crossed) is None
+    b = right_hand_side(0.2)
+    x, z = simplex.solve(a, q, b)
+    _assert_optimal(a, b, q, equalities, x, z, _highs(a, b, q, equalities).fun)
+
+
 def _pyramid_grasp(load):
     contacts = [
         Contact(name=name, role="finger", position=[0.0, side * 0.03, 0.0],

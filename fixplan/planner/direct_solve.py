@@ -220,6 +220,8 @@ class DirectSolver:
             self.status, self.method = str(solution.status), "CLARABEL"
             solved = self.status == "Solved"
             if not (solved or (accept_inaccurate and self.status == "AlmostSolved")):
+                if self.infeasible:  # (its multipliers: the certificate, see dual())
+                    self._dual = np.asarray(solution.z)
                 return False
             x, self._dual = np.asarray(solution.x), np.asarray(solution.z)
             self._optimum = (None, None, float(solution.obj_val) + constant)
@@ -287,9 +289,16 @@ class DirectSolver:
         x[column] = k
         return x, z * k
 
+    @property
+    def infeasible(self) -> bool:
+        """Whether Clarabel found the last problem primal infeasible (then :meth:`dual` gives
+        the Farkas certificate's part)."""
+        return self.status == "PrimalInfeasible"
+
     def dual(self, constraint: cp.Constraint) -> np.ndarray | None:
         """The multipliers of equality ``constraint`` after :meth:`solve`, as cvxpy gives them
-        (``constraint.dual_value``); ``None`` if it is not one of the problem's equalities."""
+        (``constraint.dual_value``: after an infeasible solve, the certificate's); ``None`` if
+        it is not one of the problem's equalities."""
         found = self._equalities.get(constraint.id)
         if found is None:
             return None

@@ -330,16 +330,10 @@ class Planner:
         return [(names[name], value) for name, value in forces.items()]
 
     def _plan(self, status, value, solver, start, notes, fields) -> Plan:
-        return Plan(
-            status=status,
-            objective=self.problem.objective,
-            objective_value=value,
-            contact_names=self._contact_names,
-            solver=solver,
-            solve_time=time.perf_counter() - start,
-            warnings=tuple(notes),
-            **fields,
-        )
+        fields.update(status=status, objective=self.problem.objective, objective_value=value,
+                      contact_names=self._contact_names, solver=solver, warnings=tuple(notes),
+                      solve_time=time.perf_counter() - start)  # fmt: skip
+        return Plan._of(fields)
 
     def _wrenches(self, normal, friction) -> np.ndarray:
         """The contact wrenches ``(C, K, 4)`` of ``normal`` ``(C, K)`` and ``friction``

@@ -572,10 +572,16 @@ class Runner:
     def _direct_result(self, key: tuple, stacked: Stacked, vector=None) -> dict | None:
         """Solve straight through Clarabel when a direct solver exists for ``key`` (with the
         parameters' values, or those of the parameter ``vector``; the answer read from the
-        solution, not through the cvxpy variables)."""
+        solution, not through the cvxpy variables). Where Clarabel finds the problem infeasible,
+        its certificate is the equilibrium's multipliers, as cvxpy would report them."""
         direct = self._direct.get(key)
-        if direct is None or not direct.solved(vector=vector):
+        if direct is None:
             return None
+        if not direct.solved(vector=vector):
+            if not direct.infeasible:
+                return None
+            return {"status": "infeasible", "solver": "CLARABEL (direct)", "warnings": [],
+                    "dual": direct.dual(stacked.balance)}  # fmt: skip
         if key not in self._readers:
             self._readers[key] = _Reader.of(stacked, direct)
         reader = self._readers[key]
