@@ -257,8 +257,8 @@ class Runner:
         disabled and none ``unloaded``.
 
         Returns ``(tried, result)``: whether the direct solver was tried, and the result in
-        newtons (``None`` where it did not apply or failed: the caller then takes the full
-        path, :meth:`_solve_block`)."""
+        newtons (optimal, or infeasible with Clarabel's certificate; ``None`` where it did not
+        apply or failed: the caller then takes the full path, :meth:`_solve_block`)."""
         key = (objective, False)
         kept = self._kept.get(key)
         if kept is None or unloaded is not None or kept.disabled != _bytes(disabled):
