@@ -57,8 +57,9 @@ STEP_FRACTION = 0.99
 WARM_SHIFT, SHIFT_MAX = 1e-3, 1e-1
 #: The iterates give up as a ray where ``|F'y + z| <= RAY_RTOL f'y`` (infeasible) or ``|F x| <=
 #: RAY_RTOL (-c'x)`` (unbounded), largest entries: a feasible point would then need entries of
-#: about ``1 / RAY_RTOL`` of the program's unit. On an infeasible re-solve of the ellipsoid
-#: grasp it gave up after 6 iterations, where ``MAX_ITERATIONS`` ran from both starts (88).
+#: about ``1 / RAY_RTOL`` of the program's unit. On unholdable re-solves of the ellipsoid grasp
+#: it gave up after 6-9 iterations, where it ran 50 from the warm start and 38 more from
+#: Mehrotra's (to a tiny step) before.
 RAY_RTOL = 1e-6
 #: A Cholesky pivot below this fraction of its diagonal entry is replaced by ``HUGE_PIVOT``.
 PIVOT_RTOL, HUGE_PIVOT = 1e-30, 1e128

@@ -25,7 +25,8 @@ program or one beyond ``BOUND``), finds the program infeasible or unbounded, or 
 ``MAX_PIVOTS_PER_ROW`` pivots per row returns ``None``: the caller then asks Clarabel, which
 also gives the infeasibility certificates. A warm start that finds the program infeasible (a
 violated row that no pivot can bring in: a dual ray) returns ``None`` at once, without the
-artificial start (about 1.7 ms on the pyramid grasp of ``benchmarks/bench_realtime.py``).
+artificial start (about 1.7 ms of an unholdable re-solve of the pyramid grasp of
+``benchmarks/bench_realtime.py``, profiled).
 """
 
 from __future__ import annotations
@@ -219,8 +220,8 @@ def dual_pivots(a, b, q, equalities, rows, inverse, x, z, limit, feasibility, op
     """Dual simplex pivots from the dual feasible basis ``rows`` (with ``inverse``, both
     updated in place) until its vertex ``x`` is feasible; ``z`` gets the multipliers. Returns
     the number of pivots, :data:`RAY` for an infeasible program (a violated row that no row can
-    leave for), or -1 (too many pivots, multipliers < 0, a singular basis). ``size`` and ``norm`` ``(m,)`` hold the rows' 1- and 2-norms (computed
-    here when ``fresh``)."""
+    leave for), or -1 (too many pivots, multipliers < 0, a singular basis). ``size`` and
+    ``norm`` ``(m,)`` hold the rows' 1- and 2-norms (computed here when ``fresh``)."""
     m, n = a.shape
     if fresh:
         for i in range(m):
