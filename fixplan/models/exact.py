@@ -57,6 +57,8 @@ class Exact(FrictionModel):
 
     surface: LimitSurface
     _seed: np.ndarray = dataclasses.field(init=False)
+    #: :meth:`_units`, kept (read-only): the planner's rounds ask for them at every query.
+    _unit_scale: np.ndarray = dataclasses.field(init=False)
 
     conservative: ClassVar[bool] = True
 
@@ -70,6 +72,9 @@ class Exact(FrictionModel):
         seed = np.vstack([directions, -directions]) / np.concatenate([support, support])[:, None]
         seed.setflags(write=False)
         object.__setattr__(self, "_seed", seed)
+        units = self._units()
+        units.setflags(write=False)
+        object.__setattr__(self, "_unit_scale", units)
 
     @classmethod
     def from_limit_surface(cls, ls: LimitSurface) -> Exact:
@@ -140,26 +145,9 @@ class Exact(FrictionModel):
         support is read from the inverse map's answer instead of being integrated again
         (relative difference about 1e-14, far below the planner's ``CUT_MARGIN``).
         """
-        planes, excess, _ = self._cuts(loads, start, curvature=False)
-        return planes, excess
-
-    def _cuts(
-        self, loads: np.ndarray, start: np.ndarray | None, *, curvature: bool
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-        """:meth:`cut`, and with ``curvature`` the Hessians ``(K, 3, 3)`` of ``h_1`` at the
-        planes ``a`` (the twists ``V`` over ``h_1(V)``; else ``None``): ``∇²h_1(a) =
-        h_1(V) ∇²h_1(V)``, ``h_1`` being homogeneous of degree 1, from the Hessians the inverse
-        map found at ``V``."""
-        scaled = loads * self.surface.normal_force
-        hessians = None
-        if curvature:
-            safety, twists, hessians = self.surface._trusted_inverse_and_hessians(scaled, start)
-        else:
-            safety, twists = self.surface._trusted_inverse(scaled, start)
+        safety, twists = self.surface._trusted_inverse(loads * self.surface.normal_force, start)
         support = safety * np.einsum("ij,ij->i", loads, twists)
-        if hessians is not None:
-            hessians = hessians * (support / self.surface.normal_force)[:, None, None]
-        return twists / support[:, None], 1.0 / safety - 1.0, hessians
+        return twists / support[:, None], 1.0 / safety - 1.0
 
     def osculating(
         self, loads: np.ndarray, start: np.ndarray | None = None
@@ -194,9 +182,13 @@ class Exact(FrictionModel):
         the same value, gradient and Hessian at ``u``. The algebra runs in normalised
         coordinates (loads over :meth:`_units`), where ``J`` is well conditioned.
         """
-        planes, excess, curvature = self._cuts(loads, start, curvature=True)
-        points = loads / (1.0 + excess)[:, None]
-        return excess, points, self._osculating_factors(planes, points, curvature)
+        scaled = loads * self.surface.normal_force
+        safety, twists, hessians = self.surface._trusted_inverse_and_hessians(scaled, start)
+        excess, points = np.empty(len(loads)), np.empty((len(loads), 3))
+        factors = np.empty((len(loads), 3, 3))
+        _RAY_OSCULATION(loads, safety, twists, hessians, self.surface.normal_force,
+                        self._unit_scale, excess, points, factors)  # fmt: skip
+        return excess, points, factors
 
     def osculating_at(self, twists: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The ellipsoid that osculates the exact set at its point with the normal ``V``.
@@ -223,12 +215,9 @@ class Exact(FrictionModel):
     def _osculating_factors(self, planes, points, curvature) -> np.ndarray:
         """Factors ``(K, 3, 3)`` of the ellipsoids with the tangent ``planes`` at ``points``
         ``(K, 3)`` and the support Hessians ``curvature`` ``(K, 3, 3)`` at the planes."""
-        units = self._units()
-        a, u = planes * units, points / units  # normalised plane and point, a · u = 1
-        curvature = curvature / (units[None, :, None] * units[None, None, :])
         factors = np.empty((len(points), 3, 3))
-        _OSCULATING_FACTORS(a, u, curvature, factors)
-        return factors / units[None, None, :]
+        _OSCULATING_FACTORS(planes, points, curvature, self._unit_scale, factors)
+        return factors
 
     def planes(self, twists: np.ndarray) -> np.ndarray:
         r"""Tangent planes :math:`a \cdot L \le N`, ``a = V / h_1(V)``, of the exact set at the
@@ -258,55 +247,93 @@ class Exact(FrictionModel):
         )
 
 
-def osculating_factors(planes, points, curvatures, out):  # pragma: no cover - compiled
-    """Upper triangular ``out[k]`` ``(3, 3)`` with ``RᵀR = (I - a uᵀ) J⁺ (I - u aᵀ) + a aᵀ`` for
-    each normalised plane ``a``, point ``u`` and support Hessian ``J`` (``J a = 0``), from
-    ``J⁺ = (J + â âᵀ)⁻¹ - â âᵀ``; NaN where that matrix is not positive definite."""
+def osculating_factor(a, u, curvature, units, r):  # pragma: no cover - compiled
+    """Upper triangular ``r`` ``(3, 3)`` with ``RᵀR = (I - a uᵀ) J⁺ (I - u aᵀ) + a aᵀ`` in
+    normalised coordinates (loads over ``units``; ``r`` then back in load units) for the plane
+    ``a``, point ``u`` and support Hessian ``J`` = ``curvature`` at ``a`` (``J a = 0``), all in
+    load units, from ``J⁺ = (J + â âᵀ)⁻¹ - â âᵀ``; NaN where that matrix is not positive
+    definite."""
+    a = a * units
+    u = u / units
+    size = np.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+    m = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            m[i, j] = curvature[i, j] / (units[i] * units[j]) + a[i] * a[j] / (size * size)
+    cof = np.empty((3, 3))
+    cof[0, 0] = m[1, 1] * m[2, 2] - m[1, 2] * m[2, 1]
+    cof[0, 1] = m[0, 2] * m[2, 1] - m[0, 1] * m[2, 2]
+    cof[0, 2] = m[0, 1] * m[1, 2] - m[0, 2] * m[1, 1]
+    cof[1, 0] = m[1, 2] * m[2, 0] - m[1, 0] * m[2, 2]
+    cof[1, 1] = m[0, 0] * m[2, 2] - m[0, 2] * m[2, 0]
+    cof[1, 2] = m[0, 2] * m[1, 0] - m[0, 0] * m[1, 2]
+    cof[2, 0] = m[1, 0] * m[2, 1] - m[1, 1] * m[2, 0]
+    cof[2, 1] = m[0, 1] * m[2, 0] - m[0, 0] * m[2, 1]
+    cof[2, 2] = m[0, 0] * m[1, 1] - m[0, 1] * m[1, 0]
+    det = m[0, 0] * cof[0, 0] + m[0, 1] * cof[1, 0] + m[0, 2] * cof[2, 0]
+    pinv = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            pinv[i, j] = cof[i, j] / det - a[i] * a[j] / (size * size)
+    away = np.empty((3, 3))  # I - a uᵀ
+    for i in range(3):
+        for j in range(3):
+            away[i, j] = (1.0 if i == j else 0.0) - a[i] * u[j]
+    shape = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            total = a[i] * a[j]
+            for p in range(3):
+                for q in range(3):
+                    total += away[i, p] * pinv[p, q] * away[j, q]
+            shape[i, j] = total
+    r[:] = 0.0
+    r[0, 0] = np.sqrt(shape[0, 0]) if shape[0, 0] > 0.0 else np.nan
+    r[0, 1] = 0.5 * (shape[0, 1] + shape[1, 0]) / r[0, 0]
+    r[0, 2] = 0.5 * (shape[0, 2] + shape[2, 0]) / r[0, 0]
+    rest = shape[1, 1] - r[0, 1] * r[0, 1]
+    r[1, 1] = np.sqrt(rest) if rest > 0.0 else np.nan
+    r[1, 2] = (0.5 * (shape[1, 2] + shape[2, 1]) - r[0, 1] * r[0, 2]) / r[1, 1]
+    rest = shape[2, 2] - r[0, 2] * r[0, 2] - r[1, 2] * r[1, 2]
+    r[2, 2] = np.sqrt(rest) if rest > 0.0 else np.nan
+    for column in range(3):
+        for row in range(column + 1):
+            r[row, column] /= units[column]
+
+
+def osculating_factors(planes, points, curvatures, units, out):  # pragma: no cover - compiled
+    """:func:`osculating_factor` of each plane ``(K, 3)``, point ``(K, 3)`` and Hessian
+    ``(K, 3, 3)`` into ``out`` ``(K, 3, 3)``."""
     for k in range(planes.shape[0]):
-        a = planes[k]
-        u = points[k]
-        size = np.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
-        m = np.empty((3, 3))
+        _OSCULATING_FACTOR(planes[k], points[k], curvatures[k], units, out[k])
+
+
+def ray_osculation(
+    loads, safety, twists, hessians, normal_force, units, excess, points, factors
+):  # pragma: no cover - compiled
+    """:meth:`Exact.osculating` from the inverse map's answers for ``loads`` ``(K, 3)`` per unit
+    normal force at ``normal_force`` [N]: the safety factors ``s``, sliding twists ``V`` and
+    Hessians of the support ``h`` at ``V``. The surface point is ``s q``, the plane ``a = V /
+    h_1(V)`` with ``h_1(V) = s q · V`` (read from the answer rather than integrated again), and
+    the Hessian of ``h_1`` at ``a`` is ``h_1(V) ∇²h(V) / N`` (``h_1`` is homogeneous of degree
+    1)."""
+    plane = np.empty(3)
+    curvature = np.empty((3, 3))
+    for k in range(loads.shape[0]):
+        support = safety[k] * (
+            loads[k, 0] * twists[k, 0] + loads[k, 1] * twists[k, 1] + loads[k, 2] * twists[k, 2]
+        )
+        excess[k] = 1.0 / safety[k] - 1.0
         for i in range(3):
+            plane[i] = twists[k, i] / support
+            points[k, i] = loads[k, i] / (1.0 + excess[k])
             for j in range(3):
-                m[i, j] = curvatures[k, i, j] + a[i] * a[j] / (size * size)
-        cof = np.empty((3, 3))
-        cof[0, 0] = m[1, 1] * m[2, 2] - m[1, 2] * m[2, 1]
-        cof[0, 1] = m[0, 2] * m[2, 1] - m[0, 1] * m[2, 2]
-        cof[0, 2] = m[0, 1] * m[1, 2] - m[0, 2] * m[1, 1]
-        cof[1, 0] = m[1, 2] * m[2, 0] - m[1, 0] * m[2, 2]
-        cof[1, 1] = m[0, 0] * m[2, 2] - m[0, 2] * m[2, 0]
-        cof[1, 2] = m[0, 2] * m[1, 0] - m[0, 0] * m[1, 2]
-        cof[2, 0] = m[1, 0] * m[2, 1] - m[1, 1] * m[2, 0]
-        cof[2, 1] = m[0, 1] * m[2, 0] - m[0, 0] * m[2, 1]
-        cof[2, 2] = m[0, 0] * m[1, 1] - m[0, 1] * m[1, 0]
-        det = m[0, 0] * cof[0, 0] + m[0, 1] * cof[1, 0] + m[0, 2] * cof[2, 0]
-        pinv = np.empty((3, 3))
-        for i in range(3):
-            for j in range(3):
-                pinv[i, j] = cof[i, j] / det - a[i] * a[j] / (size * size)
-        away = np.empty((3, 3))  # I - a uᵀ
-        for i in range(3):
-            for j in range(3):
-                away[i, j] = (1.0 if i == j else 0.0) - a[i] * u[j]
-        shape = np.empty((3, 3))
-        for i in range(3):
-            for j in range(3):
-                total = a[i] * a[j]
-                for p in range(3):
-                    for q in range(3):
-                        total += away[i, p] * pinv[p, q] * away[j, q]
-                shape[i, j] = total
-        r = out[k]
-        r[:] = 0.0
-        r[0, 0] = np.sqrt(shape[0, 0]) if shape[0, 0] > 0.0 else np.nan
-        r[0, 1] = 0.5 * (shape[0, 1] + shape[1, 0]) / r[0, 0]
-        r[0, 2] = 0.5 * (shape[0, 2] + shape[2, 0]) / r[0, 0]
-        rest = shape[1, 1] - r[0, 1] * r[0, 1]
-        r[1, 1] = np.sqrt(rest) if rest > 0.0 else np.nan
-        r[1, 2] = (0.5 * (shape[1, 2] + shape[2, 1]) - r[0, 1] * r[0, 2]) / r[1, 1]
-        rest = shape[2, 2] - r[0, 2] * r[0, 2] - r[1, 2] * r[1, 2]
-        r[2, 2] = np.sqrt(rest) if rest > 0.0 else np.nan
+                curvature[i, j] = hessians[k, i, j] * (support / normal_force)
+        _OSCULATING_FACTOR(plane, points[k], curvature, units, factors[k])
+
+
+_OSCULATING_FACTOR = compiled_scalar(osculating_factor, inline=True)
 
 
 _OSCULATING_FACTORS = compiled_scalar(osculating_factors)
+_RAY_OSCULATION = compiled_scalar(ray_osculation)

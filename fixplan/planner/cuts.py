@@ -108,7 +108,7 @@ class CutPool(ExactContacts):
         normal = self._normal_values()
         friction = np.asarray(self._friction.value, dtype=float)
         forces = normal[self._contacts]  # (E, K)
-        loads = np.moveaxis(friction[self._rows], 1, 0)  # (3, E, K)
+        loads = friction[self._rows].transpose(1, 0, 2)  # (3, E, K)
         self._round += 1
         slack = forces[None] - np.einsum("xpek,xek->pek", self._planes, loads)
         active = np.any(self._planes != 0.0, axis=0) & (slack <= ACTIVE_RTOL * forces[None])

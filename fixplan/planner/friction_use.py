@@ -53,7 +53,7 @@ class FrictionUse:
         self._kinds = np.array(kinds, dtype=np.intp)
         self._owners = np.array(owners, dtype=np.intp)
         self._first = np.array(first, dtype=np.intp)
-        self._asked_indices = np.flatnonzero(self._asked).tolist()
+        self._any_asked = bool(self._asked.any())
 
     def __call__(
         self,
@@ -76,16 +76,17 @@ class FrictionUse:
         use = np.empty(normal.shape)
         _USES(friction, normal, float(noise), self._starts, self._stops, self._asked,
               self._rows, self._kinds, self._owners, self._first, use)  # fmt: skip
-        for i in self._asked_indices:
-            ask = np.isnan(use[i])  # pressed and carrying a load
-            if known is not None:
-                found = ask & np.isfinite(known[i])
-                use[i, found] = known[i, found]
-                ask = ask & ~found
-            if ask.any():
-                use[i, ask] = friction_use(
-                    self._models[i], friction[self._slices[i]].T[ask], normal[i, ask]
-                )
+        if not self._any_asked:
+            return use
+        ask = np.isnan(use) & self._asked[:, None]  # pressed and carrying a load
+        if known is not None:
+            found = ask & np.isfinite(known)
+            use[found] = known[found]
+            ask &= ~found
+        for i in np.flatnonzero(ask.any(axis=1)):
+            use[i, ask[i]] = friction_use(
+                self._models[i], friction[self._slices[i]].T[ask[i]], normal[i, ask[i]]
+            )
         return use
 
 

@@ -181,7 +181,7 @@ class OsculatingPool(ExactContacts):
         normal = self._normal_values()
         friction = np.asarray(self._friction.value, dtype=float)
         forces = normal[self._contacts]  # (E, K)
-        loads = np.moveaxis(friction[self._rows], 1, 0)  # (3, E, K)
+        loads = friction[self._rows].transpose(1, 0, 2)  # (3, E, K)
         twists = self._twists() * self._units[:, None, :]  # (E, K, 3), normalised
         weights = self._weights(np.linalg.norm(twists, axis=2))
         noise = FRICTION_SET_RTOL * max(float(np.abs(normal).max(initial=0.0)), 1e-300)
