@@ -57,13 +57,15 @@ class Exact(FrictionModel):
 
     surface: LimitSurface
     _seed: np.ndarray = dataclasses.field(init=False)
-    #: :meth:`_units`, kept (read-only): the planner's rounds ask for them at every query.
-    _unit_scale: np.ndarray = dataclasses.field(init=False)
+    _unit_scale: np.ndarray = dataclasses.field(init=False)  # (see _units)
 
     conservative: ClassVar[bool] = True
 
     def __post_init__(self):
         surface_units(self.surface)  # checks the type
+        units = FrictionModel._units(self)
+        units.setflags(write=False)
+        object.__setattr__(self, "_unit_scale", units)
         directions = fibonacci_sphere(SEED_PLANES)[: SEED_PLANES // 2]
         shape = self.surface.friction_shape
         # A twist d in normalised coordinates is the load-space twist d / units; its plane is
@@ -72,9 +74,11 @@ class Exact(FrictionModel):
         seed = np.vstack([directions, -directions]) / np.concatenate([support, support])[:, None]
         seed.setflags(write=False)
         object.__setattr__(self, "_seed", seed)
-        units = self._units()
-        units.setflags(write=False)
-        object.__setattr__(self, "_unit_scale", units)
+
+    def _units(self) -> np.ndarray:
+        """:meth:`FrictionModel._units`, computed once (read-only): the planner's rounds ask
+        for them at every query."""
+        return self._unit_scale
 
     @classmethod
     def from_limit_surface(cls, ls: LimitSurface) -> Exact:
@@ -187,7 +191,7 @@ class Exact(FrictionModel):
         excess, points = np.empty(len(loads)), np.empty((len(loads), 3))
         factors = np.empty((len(loads), 3, 3))
         _RAY_OSCULATION(loads, safety, twists, hessians, self.surface.normal_force,
-                        self._unit_scale, excess, points, factors)  # fmt: skip
+                        self._units(), excess, points, factors)  # fmt: skip
         return excess, points, factors
 
     def osculating_at(self, twists: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -216,7 +220,7 @@ class Exact(FrictionModel):
         """Factors ``(K, 3, 3)`` of the ellipsoids with the tangent ``planes`` at ``points``
         ``(K, 3)`` and the support Hessians ``curvature`` ``(K, 3, 3)`` at the planes."""
         factors = np.empty((len(points), 3, 3))
-        _OSCULATING_FACTORS(planes, points, curvature, self._unit_scale, factors)
+        _OSCULATING_FACTORS(planes, points, curvature, self._units(), factors)
         return factors
 
     def planes(self, twists: np.ndarray) -> np.ndarray:
