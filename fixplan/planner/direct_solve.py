@@ -228,6 +228,11 @@ class DirectSolver:
         self._last = (x, vector)
         return True
 
+    @property
+    def variables(self) -> int:
+        """The size of the solution vector: :meth:`positions` below it are variables'."""
+        return self._program.variables
+
     def positions(self, piece: cp.Variable | cp.Parameter) -> np.ndarray | None:
         """Where the entries of ``piece`` (column-major) sit in what :meth:`gather` reads: a
         variable's in the solution, a parameter's in the parameter vector after it; ``None``
@@ -240,9 +245,13 @@ class DirectSolver:
             return None
         return self._program.variables + np.arange(entries.start, entries.stop)
 
-    def gather(self, positions: np.ndarray) -> np.ndarray:
-        """The last solve's values at ``positions`` (from :meth:`positions`; ``-1`` reads 0)."""
+    def gather(self, positions: np.ndarray, *, solution_only: bool = False) -> np.ndarray:
+        """The last solve's values at ``positions`` (from :meth:`positions`; ``-1`` reads 0);
+        ``solution_only`` where every position is a variable's (read without joining the
+        parameter vector to the solution)."""
         x, vector = self._last
+        if solution_only:
+            return x[positions]
         return np.concatenate((x, vector, _ZERO))[positions]
 
     def _simplex_solve(self, q, a, b) -> tuple[np.ndarray, np.ndarray] | None:

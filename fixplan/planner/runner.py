@@ -41,7 +41,7 @@ from fixplan.planner.stacking import (
     set_given,
     set_units,
 )
-from fixplan.planner.verify import LARGEST_MAGNITUDE
+from fixplan.planner.verify import LARGEST_SCALED_MAGNITUDE
 from fixplan.tolerances import CAPPED_BLOCK_RTOL, MAX_SAFETY_FACTOR
 
 SOLVERS = ("CLARABEL", "OSQP", "SCS")
@@ -131,7 +131,7 @@ class Runner:
         self._readers: dict[tuple, _Reader | None] = {}  # of the direct solves' answers
         # Task torques over the longest lever [m] of a contact's normal force are forces.
         lever = max(float(np.linalg.norm(layout.normal_map[3:], axis=0).max()), 1e-3)
-        self._per_force = np.repeat([1.0, 1.0 / lever], 3)[:, None]  # task wrench -> forces
+        self._per_force = np.repeat([1.0, 1.0 / lever], 3)  # task wrench rows -> forces
         self._weight = float(np.linalg.norm(problem.body.weight_wrench[:3]))
         #: Smooth exact models are first solved with osculating ellipsoids, conic programs that
         #: Clarabel solves (:mod:`fixplan.planner.osculating`); the cutting planes take over
@@ -473,7 +473,7 @@ class Runner:
     def _force_unit(self, wrenches: np.ndarray, given: dict) -> float:
         """The force unit [N] of a block with task ``wrenches`` ``(6, K)`` and ``given`` forces:
         the power of two that puts its largest force nearest ``FORCE_IN_UNITS``; 1 N for none."""
-        largest = max(LARGEST_MAGNITUDE(wrenches * self._per_force), self._weight)
+        largest = max(LARGEST_SCALED_MAGNITUDE(wrenches, self._per_force), self._weight)
         for value in given.values():  # (plain numbers, or arrays of the cases)
             largest = max(largest, value if isinstance(value, float) else float(np.max(value)))
         return 2.0 ** round(math.log2(largest / FORCE_IN_UNITS)) if largest > 0.0 else 1.0
@@ -720,13 +720,15 @@ class _Reader:
     """Where a direct solve's answer sits, for
     :meth:`~fixplan.planner.direct_solve.DirectSolver.gather`: the normal forces ``(C, K)``,
     friction loads ``(D, K)`` and, where they are variables, the multiples ``(K,)``, flattened
-    in that order (``scale``: the constant multiples of a force objective instead). Read so in
-    about 5.5 µs, where the values by variable id take 17."""
+    in that order (``scale``: the constant multiples of a force objective instead); whether all
+    are variables' (``solution_only``: no given normal force read from the parameters). Read so
+    in about 5.5 µs, where the values by variable id take 17."""
 
     positions: np.ndarray
     normal_shape: tuple[int, int]
     friction_shape: tuple[int, int]
     scale: np.ndarray | None
+    solution_only: bool
 
     @classmethod
     def of(cls, stacked: Stacked, direct: DirectSolver) -> _Reader | None:
@@ -749,11 +751,13 @@ class _Reader:
             if found is None:
                 return None
             flat.append(found.reshape(variable.shape, order="F").ravel())
-        return cls(np.concatenate(flat), normal.shape, stacked.friction.shape, constant)
+        positions = np.concatenate(flat)
+        solution_only = bool(np.all((positions >= 0) & (positions < direct.variables)))
+        return cls(positions, normal.shape, stacked.friction.shape, constant, solution_only)
 
     def __call__(self, direct: DirectSolver) -> dict:
         """Normal forces, friction loads and multiples of ``direct``'s last solve."""
-        values = direct.gather(self.positions)
+        values = direct.gather(self.positions, solution_only=self.solution_only)
         normal_size = self.normal_shape[0] * self.normal_shape[1]
         friction_end = normal_size + self.friction_shape[0] * self.friction_shape[1]
         return {

@@ -144,6 +144,18 @@ def largest_magnitude(values):  # pragma: no cover - compiled
     return largest
 
 
+def largest_scaled_magnitude(values, row_scales):  # pragma: no cover - compiled
+    """The largest absolute value of ``values`` ``(R, K)`` times its row's ``row_scales``
+    ``(R,)`` (0 for none; NaN if any is), without the product's array."""
+    largest = 0.0
+    for r in range(values.shape[0]):
+        for k in range(values.shape[1]):
+            value = abs(values[r, k]) * row_scales[r]
+            if not value <= largest:  # (NaN propagates)
+                largest = value
+    return largest
+
+
 def troubled(normal, use, noise):  # pragma: no cover - compiled
     """Whether a contact pulls, carries friction without normal force or exceeds its set by
     more than ``noise`` [N] (see :meth:`Verifier._friction_problems`)."""
@@ -162,5 +174,7 @@ def troubled(normal, use, noise):  # pragma: no cover - compiled
 
 #: :func:`largest_magnitude` compiled (also for the analysis).
 LARGEST_MAGNITUDE = compiled_scalar(largest_magnitude)
+#: :func:`largest_scaled_magnitude` compiled (for the planner's force unit).
+LARGEST_SCALED_MAGNITUDE = compiled_scalar(largest_scaled_magnitude)
 _EQUILIBRIUM = compiled_scalar(equilibrium)
 _TROUBLED = compiled_scalar(troubled)
