@@ -246,7 +246,7 @@ def test_answers_gathered_at_their_positions_are_the_variables_and_given_forces(
     for loads in cases:
         planner.solve(loads)
     runner = planner._runner
-    read = 0
+    read, solution_only = 0, set()
     for key, direct in runner._direct.items():
         reader = runner._readers.get(key)
         if direct is None or reader is None:
@@ -258,7 +258,9 @@ def test_answers_gathered_at_their_positions_are_the_variables_and_given_forces(
         for name, value in reader(direct).items():
             np.testing.assert_array_equal(value, through_variables[name], err_msg=name)
         read += 1
+        solution_only.add(reader.solution_only)
     assert read >= 2  # the force objective and the check (fixed forces: multiples variables)
+    assert solution_only == {True, False}  # (the check reads its given forces from the vector)
 
 
 def test_gather_reads_variables_parameters_and_zero():
@@ -272,3 +274,8 @@ def test_gather_reads_variables_parameters_and_zero():
     assert direct.solved()
     positions = np.concatenate([direct.positions(x), direct.positions(bound), [-1]])
     np.testing.assert_allclose(direct.gather(positions), [1.0, -2.0, 1.0, -2.0, 0.0], atol=1e-12)
+    variables = direct.positions(x)
+    assert variables.max() < direct.variables <= direct.positions(bound).min()
+    np.testing.assert_array_equal(
+        direct.gather(variables, solution_only=True), direct.gather(variables)
+    )

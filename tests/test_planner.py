@@ -277,6 +277,24 @@ def test_verification_measures_the_equilibrium_residual_against_the_wrench_terms
     assert any(p.startswith("equilibrium residual of load case 1") for p in problems)
 
 
+@pytest.mark.parametrize("where", ["normal", "friction"])
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_verification_flags_forces_that_are_not_finite(where, bad):
+    """A NaN or infinite force in any case fails verification, whichever case comes after it
+    (a NaN ahead of finite values must not be lost in the largest residual)."""
+    load = off_axis_load(offset=0.0)
+    planner = Planner(pinch("point-cone", load=load))
+    answer = {"normal": np.full((2, 3), 10.0), "friction": np.zeros((4, 3)),
+              "scale": np.ones(3)}  # fmt: skip
+    answer[where][1, 0] = bad  # case 1 of 3
+    wrenches = np.column_stack([load.wrench] * 3)
+    relative, problems = Verifier(planner.problem, planner.layout, planner.friction_use, 0.02)(
+        answer, wrenches
+    )
+    assert relative == np.inf
+    assert "load case 1: forces not finite (NaN or infinite)" in problems
+
+
 def test_three_point_contact_set_surface_equals_the_planar_limit_surface_of_the_points():
     xy = np.array([[0.03, 0.0], [-0.02, 0.025], [-0.02, -0.03]])
     forces = np.array([4.0, 8.0, 6.0])

@@ -59,6 +59,9 @@ class Verifier:
             for row, unit in ((0, "N"), (1, "N m")):
                 worst = int(np.argmax(ratios[row]))
                 ratio, size = ratios[row, worst], sizes[row, worst]
+                if ratio == np.inf:
+                    problems.append(f"load case {worst + 1}: forces not finite (NaN or infinite)")
+                    break
                 if ratio > EQUILIBRIUM_RTOL:
                     problems.append(
                         f"equilibrium residual of load case {worst + 1}: "
@@ -105,7 +108,8 @@ def equilibrium(normal_map, friction_map, normal, friction, wrenches, scale, gra
     """Each case's largest residual of force and of moment (rows of ``ratios`` ``(2, K)``)
     over the size of its wrench terms (``sizes``: the largest force and moment of any term,
     moments at least force × ``length_scale``); returns the largest ratio (0 for no case) and
-    the largest magnitude of ``normal`` (see :func:`largest_magnitude`)."""
+    the largest magnitude of ``normal`` (see :func:`largest_magnitude`). A row with a term that
+    is not finite (NaN or infinite) has an infinite residual."""
     largest = 0.0
     for k in range(normal.shape[1]):
         residual = np.zeros(6)
@@ -122,15 +126,15 @@ def equilibrium(normal_map, friction_map, normal, friction, wrenches, scale, gra
                 term = friction_map[row, d] * friction[d, k]
                 total += term
                 size += abs(term)
+            if not (abs(total) < np.inf and size < np.inf):  # NaN or infinite terms
+                total, size = np.inf, 1.0
             residual[row], magnitude[row] = abs(total), size
         force = max(max(magnitude[0], magnitude[1], magnitude[2]), 1e-12)
         moment = max(max(magnitude[3], magnitude[4], magnitude[5]), force * length_scale)
         sizes[0, k], sizes[1, k] = force, moment
         ratios[0, k] = max(residual[0], residual[1], residual[2]) / force
         ratios[1, k] = max(residual[3], residual[4], residual[5]) / moment
-        for ratio in (ratios[0, k], ratios[1, k]):
-            if not ratio <= largest:  # (NaN propagates)
-                largest = ratio
+        largest = max(largest, ratios[0, k], ratios[1, k])
     return largest, LARGEST_MAGNITUDE(normal)
 
 
@@ -139,8 +143,10 @@ def largest_magnitude(values):  # pragma: no cover - compiled
     largest = 0.0
     for c in range(values.shape[0]):
         for k in range(values.shape[1]):
-            if not abs(values[c, k]) <= largest:  # (NaN propagates)
-                largest = abs(values[c, k])
+            value = abs(values[c, k])
+            if value != value:  # NaN
+                return value
+            largest = max(largest, value)
     return largest
 
 
@@ -151,8 +157,9 @@ def largest_scaled_magnitude(values, row_scales):  # pragma: no cover - compiled
     for r in range(values.shape[0]):
         for k in range(values.shape[1]):
             value = abs(values[r, k]) * row_scales[r]
-            if not value <= largest:  # (NaN propagates)
-                largest = value
+            if value != value:  # NaN
+                return value
+            largest = max(largest, value)
     return largest
 
 
