@@ -469,7 +469,6 @@ def _scaling(s, z, start, size, nonneg, beta, v, lam):  # pragma: no cover - com
             if s[first] <= 0.0 or z[first] <= 0.0:
                 return False
             beta[k] = np.sqrt(s[first] / z[first])
-            lam[first] = np.sqrt(s[first] * z[first])
             continue
         s_norm = _hyperbolic_norm(s, first, dim)
         z_norm = _hyperbolic_norm(z, first, dim)
@@ -487,13 +486,8 @@ def _scaling(s, z, start, size, nonneg, beta, v, lam):  # pragma: no cover - com
         for r in range(first + 1, first + dim):
             w = (s[r] / np.sqrt(s_norm) - z[r] / np.sqrt(z_norm)) / (2.0 * gamma)
             v[r] = w * scale
-        # lambda = W z.
-        vz = 0.0
-        for r in range(first, first + dim):
-            vz += v[r] * z[r]
-        lam[first] = beta[k] * (2.0 * v[first] * vz - z[first])
-        for r in range(first + 1, first + dim):
-            lam[r] = beta[k] * (2.0 * v[r] * vz + z[r])
+    lam[:] = z  # lambda = W z
+    _apply_scaling(lam, start, size, nonneg, beta, v, False)
     return True
 
 
@@ -583,8 +577,8 @@ def _step(u, d, start, size, nonneg):  # pragma: no cover - compiled
 _largest = compiled_scalar(_largest, inline=True)
 _into_cones = compiled_scalar(_into_cones)
 _hyperbolic_norm = compiled_scalar(_hyperbolic_norm, inline=True)
-_scaling = compiled_scalar(_scaling)
 _apply_scaling = compiled_scalar(_apply_scaling)
+_scaling = compiled_scalar(_scaling)
 _jordan_product = compiled_scalar(_jordan_product)
 _jordan_solve = compiled_scalar(_jordan_solve)
 _step = compiled_scalar(_step)
