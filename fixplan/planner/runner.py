@@ -192,13 +192,25 @@ class Runner:
         ``switchable``); ``cases`` ``(K,)`` numbers the load cases among the problem's (default
         ``0 ... K-1``). The last block is padded with copies of its first case.
         """
-        numbers = np.arange(wrenches.shape[1]) if cases is None else np.asarray(cases)
+        numbers = cases
         cases = wrenches.shape[1]
+        tried = False
+        one_block = objective not in FIXED_FORCE_OBJECTIVES and cases == len(self.problem.loads)
+        if one_block and not (accurate or self.osculating):
+            # A force objective's cases are one block: straight to its kept direct solve where
+            # there is one (re-solves in a control loop), the layers below only where it fails.
+            tried, result = self._again(objective, wrenches, given, sense, unloaded, disabled)
+            if result is not None:
+                if progress is not None:
+                    progress(cases, cases)
+                return result
+        numbers = np.arange(cases) if numbers is None else np.asarray(numbers)
         block = self.block_size(objective)
         if cases == block:  # one block, no padding (re-solves in a control loop)
             result = self._run_block(
-                objective, wrenches, given, unloaded, numbers, sense, accurate, disabled
-            )
+                objective, wrenches, given, unloaded, numbers, sense, accurate, disabled,
+                direct_failed=tried,
+            )  # fmt: skip
             if progress is not None:
                 progress(cases, cases)
             return result
