@@ -87,6 +87,13 @@ MULTIPLE_ATOL = 1e-7
 #: passive normal force of the load case are solver noise, not a squeeze.
 SQUEEZE_RTOL = 1e-6
 
+#: A point (and multipliers) of a conic program found without solving it, carried from the solve
+#: of another (:mod:`fixplan.planner.optimality`), counts as feasible (and optimal) when its
+#: residuals and duality gap are below this fraction of their terms: ten times Clarabel's own
+#: tolerances in the planner (1e-9), since the carried point was solved to those in the other
+#: program.
+CERTIFICATE_RTOL = 1e-8
+
 # -- Accepted ranges of inputs ------------------------------------------------------------------
 # Physically generous bounds, checked where values enter (problem files, Problem, the command
 # line), so that arithmetic never overflows and problem sizes stay within seconds of work.

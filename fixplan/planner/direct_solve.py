@@ -24,6 +24,7 @@ import scipy.sparse as sp
 
 from fixplan.planner.cone_interior_point import ConeInteriorPoint
 from fixplan.planner.dual_simplex import DualSimplex
+from fixplan.planner.optimality import Pattern
 
 #: Largest relative difference from cvxpy's own answer accepted when the direct path is built.
 AGREEMENT_RTOL = 1e-6
@@ -59,7 +60,9 @@ class DirectSolver:
     Build with :meth:`create` after ``problem`` was solved once by cvxpy with Clarabel.
     """
 
-    def __init__(self, problem, solver, program, offsets, equalities, simplex=None, interior=None):
+    def __init__(
+        self, problem, solver, program, offsets, rows, pattern, simplex=None, interior=None
+    ):
         self._problem = problem
         self._solver = solver
         self._simplex = simplex
@@ -81,7 +84,10 @@ class DirectSolver:
         self._placement = [
             (v.id, offsets[v.id], offsets[v.id] + v.size, v.shape) for v in problem.variables()
         ]
-        self._equalities = equalities
+        #: Where each constraint's rows sit in ``z``: id -> (start, size, shape).
+        self._rows = rows
+        #: The cones of the rows and the pattern of ``A`` (its values: :meth:`program`).
+        self.pattern = pattern
         self._sign = -1.0 if isinstance(problem.objective, cp.Maximize) else 1.0  # of the value
         #: The last solve's value: ``(q, x, constant)`` of a linear program (its value taken
         #: when asked), or ``(None, None, value)`` from Clarabel (see :attr:`objective_value`).
@@ -101,14 +107,14 @@ class DirectSolver:
         data, _, inverse = problem.get_problem_data(cp.CLARABEL, solver_opts={})
         try:
             program = _Program(data[cp.settings.PARAM_PROB], problem.parameters())
-            equalities = _equality_rows(inverse[-1].inverse_data["eq_constr"])
+            rows = _constraint_rows(inverse[-1].inverse_data)
         except (AttributeError, KeyError, TypeError, ValueError):
             return None  # cvxpy internals this module does not know
         dims = data["dims"]
         if dims.exp or dims.psd or dims.p3d or program.parametric_p:
             return None
-        cones = [clarabel.ZeroConeT(dims.zero), clarabel.NonnegativeConeT(dims.nonneg)]
-        cones += [clarabel.SecondOrderConeT(k) for k in dims.soc]
+        kinds = [clarabel.ZeroConeT(dims.zero), clarabel.NonnegativeConeT(dims.nonneg)]
+        kinds += [clarabel.SecondOrderConeT(k) for k in dims.soc]
         options = clarabel.DefaultSettings()
         options.verbose = False
         options.presolve_enable = False  # keeps the rows of b, so that it can be updated
@@ -117,7 +123,7 @@ class DirectSolver:
         vector = program.parameter_vector()
         q, _ = program.cost(vector)
         a, b = program.constraints(vector)
-        solver = clarabel.DefaultSolver(program.quadratic, q, program.matrix(a), b, cones, options)
+        solver = clarabel.DefaultSolver(program.quadratic, q, program.matrix(a), b, kinds, options)
         # The offsets of the variables in Clarabel's x: those of the matrix stuffing, the last
         # reduction that sees variables (canonicalisation may add auxiliary ones before them).
         offsets = [d.var_offsets for d in inverse if hasattr(d, "var_offsets")][-1]
@@ -136,7 +142,8 @@ class DirectSolver:
             pattern = program.dense(np.ones_like(a))
             if ConeInteriorPoint.fits(dims.zero, pattern):
                 interior = ConeInteriorPoint(dims.zero, dims.nonneg, dims.soc, pattern, settings)
-        direct = cls(problem, solver, program, offsets, equalities, simplex, interior)
+        pattern = Pattern.of(*program.pattern, dims.zero, dims.nonneg, dims.soc)
+        direct = cls(problem, solver, program, offsets, rows, pattern, simplex, interior)
         columns = program.parametric_columns()
         if simplex is not None and len(columns) == 1:  # one load multiple times the loads
             direct._scaled = (int(columns[0]), DualSimplex(dims.zero, changing=True))
@@ -199,10 +206,7 @@ class DirectSolver:
         if vector is None:
             vector = self._program.parameter_vector()
         q, constant = self._program.cost(vector)
-        kept, a, b = self._constraints
-        if kept is not vector:
-            a, b = self._program.constraints(vector)
-            self._constraints = (vector, a, b)
+        a, b = self._constraints_at(vector)
         found = self._simplex_solve(q, a, b)
         method = "dual simplex"
         if found is None and self._interior is not None:
@@ -233,23 +237,58 @@ class DirectSolver:
         """The size of the solution vector: :meth:`positions` below it are variables'."""
         return self._program.variables
 
+    @property
+    def solution(self) -> tuple[np.ndarray, np.ndarray]:
+        """The last solve's ``x`` and multipliers ``z`` (``Aᵀz + q = 0``, ``z`` in the dual
+        cones), not copies."""
+        return self._last[0], self._dual
+
+    def program(self, vector: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``q``, ``A``'s values (in :attr:`pattern`) and ``b`` of the program at the parameter
+        ``vector`` (:meth:`parameter_vector`'s layout)."""
+        a, b = self._constraints_at(vector)
+        return self._program.cost(vector)[0], a, b
+
+    def _constraints_at(self, vector: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``A``'s values and ``b`` at ``vector``, kept while the same ``vector`` object holds
+        them (:meth:`write` drops them when it puts a parameter of ``A`` or ``b`` into it)."""
+        kept, a, b = self._constraints
+        if kept is not vector:
+            a, b = self._program.constraints(vector)
+            self._constraints = (vector, a, b)
+        return a, b
+
+    def slot(self, variable: cp.Variable) -> slice | None:
+        """Where ``variable``'s entries (column-major) sit in ``x``; ``None`` if not there."""
+        for key, start, stop, _ in self._placement:
+            if key == variable.id:
+                return slice(start, stop)
+        return None
+
+    def rows(self, constraint: cp.Constraint) -> slice | None:
+        """Where ``constraint``'s rows sit in ``A``, ``b`` and ``z``; ``None`` if not there."""
+        found = self._rows.get(constraint.id)
+        return None if found is None else slice(found[0], found[0] + found[1])
+
     def positions(self, piece: cp.Variable | cp.Parameter) -> np.ndarray | None:
         """Where the entries of ``piece`` (column-major) sit in what :meth:`gather` reads: a
         variable's in the solution, a parameter's in the parameter vector after it; ``None``
         for a parameter the compiled program does not use."""
-        for key, start, stop, _ in self._placement:
-            if key == piece.id:
-                return np.arange(start, stop)
+        found = self.slot(piece)
+        if found is not None:
+            return np.arange(found.start, found.stop)
         entries = self._program.entries(piece)
         if entries is None:
             return None
         return self._program.variables + np.arange(entries.start, entries.stop)
 
-    def gather(self, positions: np.ndarray, *, solution_only: bool = False) -> np.ndarray:
-        """The last solve's values at ``positions`` (from :meth:`positions`; ``-1`` reads 0);
-        ``solution_only`` where every position is a variable's (read without joining the
-        parameter vector to the solution)."""
-        x, vector = self._last
+    def gather(
+        self, positions: np.ndarray, *, solution_only: bool = False, point: tuple | None = None
+    ) -> np.ndarray:
+        """The last solve's values at ``positions`` (from :meth:`positions`; ``-1`` reads 0),
+        or those of ``point`` (``x`` and its parameter vector); ``solution_only`` where every
+        position is a variable's (read without joining the parameter vector to ``x``)."""
+        x, vector = self._last if point is None else point
         if solution_only:
             return x[positions]
         return np.concatenate((x, vector, _ZERO))[positions]
@@ -308,8 +347,8 @@ class DirectSolver:
         """The multipliers of equality ``constraint`` after :meth:`solve`, as cvxpy gives them
         (``constraint.dual_value``: after an infeasible solve, the certificate's); ``None`` if
         it is not one of the problem's equalities."""
-        found = self._equalities.get(constraint.id)
-        if found is None:
+        found = self._rows.get(constraint.id)
+        if found is None or found[0] + found[1] > self.pattern.zero:
             return None
         start, size, shape = found
         return self._dual[start : start + size].reshape(shape, order="F")
@@ -437,6 +476,12 @@ class _Program:
         columns = np.repeat(np.arange(self._a_shape[1]), np.diff(self._a_indptr))
         return np.unique(columns[entries])
 
+    @property
+    def pattern(self) -> tuple[np.ndarray, np.ndarray]:
+        """``A``'s compressed-column pattern: the row of each value, and where each column's
+        values start."""
+        return self._a_rows[: self._split], self._a_indptr
+
     def dense(self, values) -> np.ndarray:
         """Clarabel's ``A`` from its ``values``, as a dense array."""
         if self._dense_index is None:
@@ -448,8 +493,7 @@ class _Program:
 
     def matrix(self, values) -> sp.csc_matrix:
         """Clarabel's ``A`` from its ``values``."""
-        pattern = (self._a_rows[: self._split], self._a_indptr)
-        return sp.csc_matrix((values, *pattern), shape=self._a_shape)
+        return sp.csc_matrix((values, *self.pattern), shape=self._a_shape)
 
 
 def same_values(a: np.ndarray | None, b: np.ndarray | None) -> bool:
@@ -464,10 +508,11 @@ def _for_products(matrix: sp.csr_array):
     return matrix.toarray() if matrix.shape[0] * matrix.shape[1] <= DENSE_MAX_ENTRIES else matrix
 
 
-def _equality_rows(constraints) -> dict:
-    """Row offset, size and shape of each equality constraint (by id) in Clarabel's zero cone."""
+def _constraint_rows(inverse_data: dict) -> dict:
+    """Row offset, size and shape of each constraint (by id) in Clarabel's rows: the equality
+    constraints in its zero cone, then the others in its nonnegative and second-order cones."""
     rows, start = {}, 0
-    for constraint in constraints:
+    for constraint in [*inverse_data["eq_constr"], *inverse_data["other_constr"]]:
         rows[constraint.id] = (start, constraint.size, constraint.shape)
         start += constraint.size
     return rows

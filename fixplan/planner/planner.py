@@ -194,11 +194,13 @@ class Planner:
             extra = self._intervals(result, wrenches, given, progress, off)
         elif analyse and status == "optimal":
             planned = {i: f for i, f in self._indexed(forces)}
-            checked = self._squeeze_free(
+            ends = self._carried_ends(wrenches, planned, progress, off)
+            checked = ends.get("highest") or self._squeeze_free(
                 "check", wrenches, planned, squeezed, progress=progress, disabled=off
             )
             if checked["status"] in ("optimal", "inaccurate"):
-                extra = self._intervals(checked, wrenches, planned, progress, off)
+                extra = self._intervals(checked, wrenches, planned, progress, off,
+                                        lowest=ends.get("lowest"))  # fmt: skip
             else:
                 notes.append(f"safety analysis of the forces found: {checked['status']}")
                 extra = {}
@@ -245,14 +247,28 @@ class Planner:
         )
         return refined if refined["status"] == "optimal" else result
 
-    def _intervals(self, highest, wrenches, given, progress, disabled=None) -> dict:
+    def _intervals(self, highest, wrenches, given, progress, disabled=None, lowest=None) -> dict:
         """Held intervals, motions and utilisation of the given forces (``highest``: the
-        maximising fixed-force solve)."""
-        lowest = self._lowest(wrenches, given, progress, disabled)
+        maximising fixed-force solve; ``lowest``: the minimising one, solved here if ``None``).
+        """
+        if lowest is None:
+            lowest = self._lowest(wrenches, given, progress, disabled)
         if lowest["status"] not in ("optimal", "inaccurate"):
             lowest = None
         return analyse_cases(self.problem, self.friction_use, self._staying, highest, lowest,
                              wrenches, self.length_scale)  # fmt: skip
+
+    def _carried_ends(self, wrenches, given, progress, disabled=None) -> dict:
+        """The ends of the held interval of a single load case that the force solve just made
+        certifies for its forces ``given`` (see
+        :meth:`~fixplan.planner.runner.Runner.carried_ends`; not with squeezable contacts, whose
+        unloading is per solve)."""
+        if self.squeeze_contacts:
+            return {}
+        ends = self._runner.carried_ends(wrenches, given, disabled)
+        if "highest" in ends and progress is not None:
+            progress(1, 1)
+        return ends
 
     def _lowest(self, wrenches, given, progress, disabled=None) -> dict:
         """The minimising fixed-force solve: ``scale`` holds ``k_min`` of every case.
@@ -278,6 +294,10 @@ class Planner:
 
         cases = wrenches.shape[1]
         if not self.squeeze_contacts:
+            if self._runner.held_without_load(wrenches, given, disabled):
+                if progress is not None:
+                    progress(cases, cases)
+                return {"status": "optimal", "scale": np.zeros(cases)}
             found = self._runner.with_sense("check", wrenches, given, -1.0, disabled)
             if found is not None:
                 if progress is not None:

@@ -28,6 +28,7 @@ import cvxpy as cp
 import numpy as np
 
 from fixplan.errors import FixplanError, InvalidArgumentError
+from fixplan.planner.carried import Carried, WithoutLoad
 from fixplan.planner.direct_solve import DirectSolver, same_values
 from fixplan.planner.osculating import OsculatingPool, smooth
 from fixplan.planner.parameters import assign
@@ -42,7 +43,7 @@ from fixplan.planner.stacking import (
     set_units,
 )
 from fixplan.planner.verify import LARGEST_SCALED_MAGNITUDE
-from fixplan.tolerances import CAPPED_BLOCK_RTOL, MAX_SAFETY_FACTOR
+from fixplan.tolerances import CAPPED_BLOCK_RTOL, CERTIFICATE_RTOL, MAX_SAFETY_FACTOR
 
 SOLVERS = ("CLARABEL", "OSQP", "SCS")
 
@@ -129,6 +130,12 @@ class Runner:
         self._units: dict[tuple, float] = {}  # the force unit [N] each problem was last set in
         self._kept: dict[tuple, _Kept] = {}  # see _again
         self._readers: dict[tuple, _Reader | None] = {}  # of the direct solves' answers
+        #: The key of the program whose direct solve gave the last result (``None``: the last
+        #: solve went through cvxpy), and the maps of its optimum into ``check``'s (see
+        #: :meth:`carried_ends`, :meth:`held_without_load`).
+        self._source: tuple | None = None
+        self._carry: dict[tuple, Carried | None] = {}
+        self._without_load: dict[tuple, WithoutLoad] = {}
         # Task torques over the longest lever [m] of a contact's normal force are forces.
         lever = max(float(np.linalg.norm(layout.normal_map[3:], axis=0).max()), 1e-3)
         self._per_force = np.repeat([1.0, 1.0 / lever], 3)  # task wrench rows -> forces
@@ -263,23 +270,33 @@ class Runner:
 
     def _again(self, objective, wrenches, given, sense, unloaded, disabled) -> tuple:
         """A block straight through the direct solver of ``objective``, its parameters written
-        into the parameter vector of its last direct solve (:class:`_Kept`) rather than set
-        through cvxpy: the task wrenches, and the given forces and ``sense`` where they
-        changed. Applies where that solve was in the same force unit, with the same contacts
-        disabled and none ``unloaded``.
+        into the parameter vector of its last direct solve (:meth:`_written`).
 
         Returns ``(tried, result)``: whether the direct solver was tried, and the result in
         newtons (optimal, or infeasible with Clarabel's certificate; ``None`` where it did not
         apply or failed: the caller then takes the full path, :meth:`_solve_block`)."""
         key = (objective, False)
+        kept = self._written(key, wrenches, given, sense, unloaded, disabled)
+        if kept is None:
+            return False, None
+        return True, self._direct_result(key, self._built[key], kept.vector, kept.unit)
+
+    def _written(self, key, wrenches, given, sense, unloaded, disabled) -> _Kept | None:
+        """The kept state of ``key``'s last direct solve (:class:`_Kept`) with these task
+        wrenches, and the given forces, ``sense`` and force unit where they changed, written
+        into its parameter vector rather than set through cvxpy. Applies where that solve had
+        the same contacts disabled and none ``unloaded`` (else ``None``).
+        """
         kept = self._kept.get(key)
         if kept is None or unloaded is not None or kept.disabled != _bytes(disabled):
-            return False, None
-        unit = self._force_unit(wrenches, given)
-        if unit != kept.unit:
-            return False, None
+            return None
         stacked, direct = self._built[key], self._direct[key]
         vector = kept.vector
+        unit = self._force_unit(wrenches, given)
+        if unit != kept.unit:  # (the Parameters keep theirs: see _set_parameters)
+            set_units(stacked, self.problem.body.weight_wrench, unit,
+                      put=lambda parameter, value: direct.write(vector, parameter, value))  # fmt: skip
+            kept.unit, kept.given = unit, None  # (the given forces are written again)
         direct.write(vector, stacked.task, wrenches / unit)
         kept.wrenches = wrenches.copy()
         state = _given_state(given)
@@ -298,11 +315,93 @@ class Runner:
             kept.given = state
             if through_parameters:
                 self._given[key] = None if state is None else (unit, state)
+        self._sensed(key, sense)
+        return kept
+
+    def _sensed(self, key, sense: float) -> None:
+        """Write ``sense`` into ``key``'s kept parameter vector where it differs."""
+        kept, stacked = self._kept[key], self._built[key]
         if stacked.sense is not None and sense != kept.sense:
-            direct.write(vector, stacked.sense, float(sense))
+            self._direct[key].write(kept.vector, stacked.sense, float(sense))
             kept.sense = sense
-        result = self._direct_result(key, stacked, vector)
-        return True, None if result is None else _in_newtons(result, unit, objective)
+
+    def carried_ends(self, wrenches: np.ndarray, given: dict, disabled=None) -> dict:
+        """The ends of the held interval of a single load case (task wrench ``(6, 1)``) at the
+        ``given`` forces that need no solve of ``check`` (:mod:`fixplan.planner.carried`):
+        ``"highest"`` where the last solve, direct and of a force objective whose forces these
+        are, certifies ``k_max = 1`` (a result as :meth:`run` returns it, with the multipliers),
+        ``"lowest"`` where it certifies ``k_min = 1`` or the forces hold the part without task
+        load (``k_min = 0``, :meth:`held_without_load`). Empty where none applies."""
+        key = ("check", False)
+        if wrenches.shape[1] != 1:
+            return {}
+        kept = self._written(key, wrenches, given, 1.0, None, disabled)
+        if kept is None:
+            return {}
+        direct = self._direct[key]
+        q, values, b = direct.program(kept.vector)
+        ends = {}
+        source, unit = self._source or (None, 1.0)
+        forces_solved = source is not None and source[0] not in FIXED_FORCE_OBJECTIVES
+        carried = self._carried(source) if forces_solved else None
+        if carried is not None:
+            solution, ratio = self._direct[source].solution, unit / kept.unit
+            alpha, worst, x, z = carried.carry(solution, ratio, q, values, b)
+            if alpha < 0.0:  # the other end: the multiple minimised
+                self._sensed(key, -1.0)
+                q = direct.program(kept.vector)[0]
+                alpha, worst, x, z = carried.carry(solution, ratio, q, values, b)
+            if worst <= CERTIFICATE_RTOL and kept.sense > 0.0:
+                ends["highest"] = self._carried_result(key, kept, x, z[carried.balance])
+            elif worst <= CERTIFICATE_RTOL:
+                ends["lowest"] = {"status": "optimal", "scale": np.ones(1)}
+        if "lowest" not in ends and self._without(key).held(values, b):
+            ends["lowest"] = {"status": "optimal", "scale": np.zeros(1)}
+        return ends
+
+    def _carried_result(self, key, kept: _Kept, x: np.ndarray, dual: np.ndarray) -> dict:
+        """The result, in newtons, of ``key``'s program at the point ``x`` of its kept
+        parameter vector, with the equilibrium's multipliers ``dual``."""
+        stacked, direct = self._built[key], self._direct[key]
+        answer = self._readers[key](direct, point=(x, kept.vector))
+        dual = dual.reshape(stacked.balance.shape, order="F")
+        result = {"status": "optimal", "solver": "carried from the force solve", "warnings": [],
+                  **answer, "dual": dual}  # fmt: skip
+        return _in_newtons(result, kept.unit, key[0])
+
+    def held_without_load(self, wrenches: np.ndarray, given: dict, disabled=None) -> bool:
+        """Whether the ``given`` forces and the weight alone are held with no friction, so that
+        a single load case (task wrench ``(6, 1)``) has ``k_min = 0`` without a solve
+        (:class:`~fixplan.planner.carried.WithoutLoad`); ``False`` where this does not show it
+        (or ``check`` has no kept direct solve for these forces)."""
+        key = ("check", False)
+        if wrenches.shape[1] != 1:
+            return False
+        kept = self._written(key, wrenches, given, -1.0, None, disabled)
+        if kept is None:
+            return False
+        _, values, b = self._direct[key].program(kept.vector)
+        return self._without(key).held(values, b)
+
+    def _without(self, key: tuple) -> WithoutLoad:
+        """The point of ``key``'s program without task load (built once)."""
+        if key not in self._without_load:
+            self._without_load[key] = WithoutLoad(self._built[key], self._direct[key])
+        return self._without_load[key]
+
+    def _carried(self, source: tuple) -> Carried | None:
+        """The map from ``source``'s program to ``check``'s (built once)."""
+        key = ("check", False)
+        if source not in self._carry:
+            self._carry[source] = Carried.between(
+                self._built[source], self._direct[source], self._built[key], self._direct[key]
+            )
+            if (
+                self._readers.setdefault(key, _Reader.of(self._built[key], self._direct[key]))
+                is None
+            ):
+                self._carry[source] = None  # (its answers are read through cvxpy)
+        return self._carry[source]
 
     def with_sense(self, objective, wrenches, given, sense, disabled=None) -> dict | None:
         """The fixed-force ``objective`` solved again with ``sense`` where the parameter
@@ -321,12 +420,8 @@ class Runner:
             or not same_values(kept.wrenches, wrenches)
         ):
             return None
-        stacked, direct = self._built[key], self._direct[key]
-        if sense != kept.sense:
-            direct.write(kept.vector, stacked.sense, float(sense))
-            kept.sense = sense
-        result = self._direct_result(key, stacked, kept.vector)
-        return None if result is None else _in_newtons(result, kept.unit, objective)
+        self._sensed(key, sense)
+        return self._direct_result(key, self._built[key], kept.vector, kept.unit)
 
     def _run_block(
         self, objective, wrenches, given, unloaded, numbers, sense, accurate, disabled,
@@ -450,12 +545,12 @@ class Runner:
             if not (accurate or exact or tried):
                 direct = self._direct.get(key)
                 vector = None if direct is None else direct.parameter_vector()
-                result = None if vector is None else self._direct_result(key, stacked, vector)
+                result = None if vector is None else self._direct_result(key, stacked, vector, unit)
                 if result is not None:
                     if unloaded is None:  # (osculating programs are never solved directly)
                         self._kept[key] = _Kept(unit, _bytes(disabled), _given_state(given),
                                                 float(sense), vector, wrenches.copy())  # fmt: skip
-                    return _in_newtons(result, unit, objective)
+                    return result
                 tried = key in self._direct
             if osculating:
                 cases = [(objective, sense, n, wrenches[:, j]) for j, n in enumerate(numbers)]
@@ -548,6 +643,7 @@ class Runner:
         ``direct_first``: not where the direct solver just failed). Returns the status and
         whether the rounds settled (always, but for osculating ellipsoids)."""
         direct = direct_first
+        self._source = None
 
         def once() -> str:
             nonlocal direct
@@ -581,26 +677,30 @@ class Runner:
         stacked.balance.save_dual_value(dual)
         return True
 
-    def _direct_result(self, key: tuple, stacked: Stacked, vector=None) -> dict | None:
+    def _direct_result(self, key: tuple, stacked: Stacked, vector, unit: float) -> dict | None:
         """Solve straight through Clarabel when a direct solver exists for ``key`` (with the
-        parameters' values, or those of the parameter ``vector``; the answer read from the
-        solution, not through the cvxpy variables). Where Clarabel finds the problem infeasible,
-        its certificate is the equilibrium's multipliers, as cvxpy would report them."""
+        parameters of the parameter ``vector``, in the force ``unit`` [N]; the answer read from
+        the solution, not through the cvxpy variables), the result in newtons. Where Clarabel
+        finds the problem infeasible, its certificate is the equilibrium's multipliers, as cvxpy
+        would report them."""
+        self._source = None
         direct = self._direct.get(key)
         if direct is None:
             return None
         if not direct.solved(vector=vector):
             if not direct.infeasible:
                 return None
-            return {"status": "infeasible", "solver": "CLARABEL (direct)", "warnings": [],
-                    "dual": direct.dual(stacked.balance)}  # fmt: skip
+            result = {"status": "infeasible", "solver": "CLARABEL (direct)", "warnings": [],
+                      "dual": direct.dual(stacked.balance)}  # fmt: skip
+            return _in_newtons(result, unit, key[0])
         if key not in self._readers:
             self._readers[key] = _Reader.of(stacked, direct)
         reader = self._readers[key]
         answer = _values(stacked, direct.values()) if reader is None else reader(direct)
-        solver = f"{direct.method} (direct)"
-        return {"status": "optimal", "solver": solver, "warnings": [], **answer,
-                "dual": direct.dual(stacked.balance)}  # fmt: skip
+        self._source = (key, unit)
+        result = {"status": "optimal", "solver": f"{direct.method} (direct)", "warnings": [],
+                  **answer, "dual": direct.dual(stacked.balance)}  # fmt: skip
+        return _in_newtons(result, unit, key[0])
 
     def _prepare_direct(self, key: tuple, stacked: Stacked) -> None:
         """Build the direct solver of an objective after its second cvxpy solve.
@@ -767,9 +867,10 @@ class _Reader:
         solution_only = bool(np.all((positions >= 0) & (positions < direct.variables)))
         return cls(positions, normal.shape, stacked.friction.shape, constant, solution_only)
 
-    def __call__(self, direct: DirectSolver) -> dict:
-        """Normal forces, friction loads and multiples of ``direct``'s last solve."""
-        values = direct.gather(self.positions, solution_only=self.solution_only)
+    def __call__(self, direct: DirectSolver, point: tuple | None = None) -> dict:
+        """Normal forces, friction loads and multiples of ``direct``'s last solve (or of
+        ``point``, an ``x`` of its program and the parameter vector it was found at)."""
+        values = direct.gather(self.positions, solution_only=self.solution_only, point=point)
         normal_size = self.normal_shape[0] * self.normal_shape[1]
         friction_end = normal_size + self.friction_shape[0] * self.friction_shape[1]
         return {

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import cvxpy as cp
 import numpy as np
@@ -185,6 +185,12 @@ class Stacked:
     disabled : cvxpy.Parameter or None
         ``(C,)``: 1 where a contact is switched off (its normal force held at 0, so its friction
         load too), for layouts that use some of the contacts (``switchable`` in :func:`build`).
+    roles : dict
+        The problem's constraints by what they state: ``"balance"``, ``"friction-<cone>"`` (the
+        friction sets, one per cone kind and size), ``"sign-<piece>"``, ``"limit-<piece>"``,
+        ``"disabled-<piece>"`` (``<piece>``: passive, finger or clamp), ``"multiple-lower"``,
+        ``"multiple-upper"``, ``"unloaded"``, ``"exact-<n>"``. Programs of other objectives
+        built for the same problem state each role alike (:mod:`fixplan.planner.carried`).
     """
 
     problem: cp.Problem
@@ -204,6 +210,7 @@ class Stacked:
     exact: CutPool | OsculatingPool | None
     limits: tuple = ()
     disabled: cp.Parameter | None = None
+    roles: dict = field(default_factory=dict)
 
 
 def build(
@@ -260,17 +267,18 @@ def build(
     friction = cp.Variable((layout.friction_map.shape[1], cases), name="friction")
     aux = cp.Variable((layout.aux_size, cases), name="aux") if layout.aux_size else None
 
-    constraints = []
+    constraints = {}  # by role (see Stacked.roles)
     for key in ("passive", "finger", "clamp"):
         rows = [k for k, i in enumerate(groups[key]) if layout.signed[i]]
         if rows:
-            constraints.append(pieces[key][rows] >= 0.0)
+            constraints[f"sign-{key}"] = pieces[key][rows] >= 0.0
     task = cp.Parameter((6, cases), name="task_wrenches")
     gravity = cp.Parameter(6, name="gravity_wrench")
     sense = None
     if scaling:
         scale = cp.Variable(cases, name="scale")
-        constraints += [scale >= 0.0, scale <= MAX_SAFETY_FACTOR]
+        constraints["multiple-lower"] = scale >= 0.0
+        constraints["multiple-upper"] = scale <= MAX_SAFETY_FACTOR
         task_term = task @ cp.diag(scale)
         sense = cp.Parameter(name="sense", value=1.0)
     else:
@@ -280,17 +288,17 @@ def build(
     balance = (
         layout.normal_map @ normal + layout.friction_map @ friction + task_term + gravity_term == 0
     )
-    constraints.append(balance)
+    constraints["balance"] = balance
     for (kind, size), (on_normal, on_friction, on_aux) in layout.cones.items():
         rows = on_normal @ normal + on_friction @ friction
         if aux is not None and on_aux.nnz:
             rows = rows + on_aux @ aux
         if kind == "zero":
-            constraints.append(rows == 0)
+            constraints[f"friction-{kind}"] = rows == 0
         elif kind == "nonneg":
-            constraints.append(rows >= 0)
+            constraints[f"friction-{kind}"] = rows >= 0
         else:
-            constraints.append(soc_columns(rows, size))
+            constraints[f"friction-{kind}-{size}"] = soc_columns(rows, size)
     limits = []
     for key in ("finger", "clamp"):
         bounded = [(k, contacts[i].max_force) for k, i in enumerate(groups[key])
@@ -302,7 +310,7 @@ def build(
             variable = pieces[key][list(rows)]
             if key == "finger":
                 bound = cp.reshape(bound, (len(rows), 1), order="F") @ ones
-            constraints.append(variable <= bound)
+            constraints[f"limit-{key}"] = variable <= bound
     if layout.osculating:
         exact = OsculatingPool.of(layout.models, layout.slices, normal, friction,
                                   normal_parts=tuple(normal_parts), wrenches=layout.friction_map,
@@ -312,12 +320,12 @@ def build(
                            normal_parts=tuple(normal_parts), wrenches=layout.friction_map,
                            balance=balance)  # fmt: skip
     if exact is not None:
-        constraints += exact.constraints
+        constraints.update({f"exact-{n}": c for n, c in enumerate(exact.constraints)})
     unloaded = None
     if squeeze and groups["passive"]:
         unloaded = cp.Parameter((len(groups["passive"]), cases), nonneg=True, name="unloaded")
         unloaded.value = np.zeros(unloaded.shape)
-        constraints.append(cp.multiply(unloaded, pieces["passive"]) == 0)
+        constraints["unloaded"] = cp.multiply(unloaded, pieces["passive"]) == 0
     disabled = None
     if switchable:
         disabled = cp.Parameter(count, nonneg=True, name="disabled", value=np.zeros(count))
@@ -326,7 +334,7 @@ def build(
                 switch = disabled[np.asarray(groups[key])]
                 if key != "clamp":
                     switch = cp.reshape(switch, (len(groups[key]), 1), order="F") @ ones
-                constraints.append(cp.multiply(switch, pieces[key]) == 0)
+                constraints[f"disabled-{key}"] = cp.multiply(switch, pieces[key]) == 0
 
     free_index = groups["finger"] + groups["clamp"]
     goal = objective_expression(
@@ -337,7 +345,7 @@ def build(
         fingers=pieces["finger"] if groups["finger"] else None,
         free_forces=normal[sorted(free_index), :] if free_index else None,
     )
-    compiled = cp.Problem(goal, constraints)
+    compiled = cp.Problem(goal, list(constraints.values()))
     decided = np.ones(count, dtype=bool)
     decided[groups["given-finger"] + groups["given-clamp"]] = False
     return Stacked(
@@ -362,6 +370,7 @@ def build(
         exact=exact,
         limits=tuple(limits),
         disabled=disabled,
+        roles=constraints,
     )
 
 
@@ -372,12 +381,15 @@ def normal_forces(stacked: Stacked, solved: dict | None = None) -> np.ndarray:
     return part_values(stacked.normal_parts, shape, solved)
 
 
-def set_units(stacked: Stacked, weight_wrench: np.ndarray, unit: float = 1.0) -> None:
+def set_units(
+    stacked: Stacked, weight_wrench: np.ndarray, unit: float = 1.0, put: Callable = assign
+) -> None:
     """Set the gravity wrench ``(6,)`` [N, N m] and the ``max_force`` bounds, both divided by
-    the force ``unit`` [N] in which the program is solved (see :mod:`fixplan.planner.runner`)."""
-    assign(stacked.gravity, np.asarray(weight_wrench, dtype=float) / unit)
+    the force ``unit`` [N] in which the program is solved (see :mod:`fixplan.planner.runner`),
+    through ``put(parameter, value)`` (default :func:`~fixplan.planner.parameters.assign`)."""
+    put(stacked.gravity, np.asarray(weight_wrench, dtype=float) / unit)
     for parameter, forces in stacked.limits:
-        assign(parameter, forces / unit)
+        put(parameter, forces / unit)
 
 
 def set_given(stacked: Stacked, values: dict, unit: float = 1.0, put: Callable = assign) -> None:
