@@ -235,7 +235,7 @@ def test_verification_flags_a_wrench_outside_its_friction_set():
     friction = np.array([[0.0], [5.0], [0.0], [6.0]])  # 6 N > mu * 10 N on the second finger
     wrenches = np.column_stack([off_axis_load(offset=0.0).wrench])
     answer = {"normal": normal, "friction": friction, "scale": np.ones(1)}
-    _, problems = Verifier(planner.problem, planner.layout, planner.friction_use, 0.02)(
+    _, problems, _ = Verifier(planner.problem, planner.layout, planner.friction_use, 0.02)(
         answer, wrenches
     )
     assert any("'right' exceeds its friction set" in p for p in problems)
@@ -247,7 +247,7 @@ def test_verification_flags_a_pulling_contact_and_friction_without_normal_force(
     friction = np.array([[0.0], [0.0], [2.0], [0.0]])  # yet carries 2 N
     wrenches = np.column_stack([off_axis_load(offset=0.0).wrench])
     answer = {"normal": normal, "friction": friction, "scale": np.ones(1)}
-    _, problems = Verifier(planner.problem, planner.layout, planner.friction_use, 0.02)(
+    _, problems, _ = Verifier(planner.problem, planner.layout, planner.friction_use, 0.02)(
         answer, wrenches
     )
     assert any("'left' pulls: normal force -1 N" in p for p in problems)
@@ -261,7 +261,7 @@ def test_verification_measures_the_equilibrium_residual_against_the_wrench_terms
     friction = np.zeros((4, 2))  # no friction: nothing holds the weight
     wrenches = np.column_stack([load.wrench, 2.0 * load.wrench])
     answer = {"normal": normal, "friction": friction, "scale": np.array([1.0, 0.5])}
-    relative, problems = Verifier(planner.problem, planner.layout, planner.friction_use, 0.02)(
+    relative, problems, _ = Verifier(planner.problem, planner.layout, planner.friction_use, 0.02)(
         answer, wrenches
     )
     # Straight from the definition: the residual's largest force over the largest sum of the
@@ -288,7 +288,7 @@ def test_verification_flags_forces_that_are_not_finite(where, bad):
               "scale": np.ones(3)}  # fmt: skip
     answer[where][1, 0] = bad  # case 1 of 3
     wrenches = np.column_stack([load.wrench] * 3)
-    relative, problems = Verifier(planner.problem, planner.layout, planner.friction_use, 0.02)(
+    relative, problems, _ = Verifier(planner.problem, planner.layout, planner.friction_use, 0.02)(
         answer, wrenches
     )
     assert relative == np.inf

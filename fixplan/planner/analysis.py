@@ -44,7 +44,8 @@ def analyse_cases(
 ) -> dict:
     """Plan fields from the maximising (``highest``) and minimising (``lowest``) fixed-force
     solves of every load case; ``staying`` projects the motions onto those that keep the
-    contacts whose normal force the solve chose in contact."""
+    contacts whose normal force the solve chose in contact. ``highest`` may hold the friction
+    use of its loads (``"use"``, already verified), else it is computed here."""
     names = [load.name for load in problem.loads]
     k_max = np.array(highest["scale"], dtype=float)
     k_min = np.zeros_like(k_max) if lowest is None else np.array(lowest["scale"], dtype=float)
@@ -59,9 +60,11 @@ def analyse_cases(
         for j in range(len(high)):
             if high[j] < np.inf and moving[j]:
                 motions[names[j]] = Screw.from_twist(twists[:, j], length_scale)
-    noise = FRICTION_SET_RTOL * max(LARGEST_MAGNITUDE(normal), 1e-12)
-    known = highest.get("known_use")
-    utilisation = np.minimum(friction_use(friction, normal, noise=noise, known=known), 1.0)
+    use = highest.get("use")
+    if use is None:
+        noise = FRICTION_SET_RTOL * max(LARGEST_MAGNITUDE(normal), 1e-12)
+        use = friction_use(friction, normal, noise=noise, known=highest.get("known_use"))
+    utilisation = np.minimum(use, 1.0)
     return {
         "safety_factors": dict(zip(names, high, strict=True)),
         "safety_factor": min(high),

@@ -176,14 +176,14 @@ class Planner:
         if status not in ("optimal", "inaccurate"):
             notes += self._squeeze_notes(squeezed)
             return self._plan(status, None, result["solver"], start, notes, fields)
-        residual, problems = self._verify(result, wrenches)
+        residual, problems, use = self._verify(result, wrenches)
         if problems and result["solver"].startswith(("CLARABEL", "dual simplex", "interior point")):
             retry = self._squeeze_free(
                 objective, wrenches, given, squeezed, accurate=True, disabled=off
             )
             if retry["status"] == "optimal":
                 result = self._refine(objective, retry, wrenches, given, squeezed, off)
-                residual, problems = self._verify(result, wrenches)
+                residual, problems, use = self._verify(result, wrenches)
         if problems:
             status = "inaccurate"
             notes += problems
@@ -195,6 +195,8 @@ class Planner:
         elif analyse and status == "optimal":
             planned = {i: f for i, f in self._indexed(forces)}
             ends = self._carried_ends(wrenches, planned, progress, off)
+            if "highest" in ends:  # (the loads verified just now)
+                ends["highest"]["use"] = use
             checked = ends.get("highest") or self._squeeze_free(
                 "check", wrenches, planned, squeezed, progress=progress, disabled=off
             )

@@ -41,8 +41,10 @@ class Verifier:
         self._use = friction_use
         self._length_scale = length_scale
 
-    def __call__(self, answer: dict, wrenches: np.ndarray) -> tuple[float, list[str]]:
-        """The largest relative equilibrium residual of ``answer`` and what failed, in words.
+    def __call__(self, answer: dict, wrenches: np.ndarray) -> tuple[float, list[str], np.ndarray]:
+        """The largest relative equilibrium residual of ``answer``, what failed, in words, and
+        the friction use ``(C, K)`` of its loads (:class:`~fixplan.planner.friction_use.
+        FrictionUse`, with the noise of the largest normal force, as the analysis takes it).
 
         ``answer`` holds ``normal`` ``(C, K)`` [N], ``friction`` ``(D, K)`` and ``scale``
         ``(K,)``; ``wrenches`` ``(6, K)`` are the task wrenches. Forces are compared with the
@@ -73,7 +75,7 @@ class Verifier:
         use = self._use(friction, normal, noise=noise, known=answer.get("known_use"))
         if _TROUBLED(normal, use, noise):
             problems += self._friction_problems(normal, use, noise, scale_force)
-        return relative, problems
+        return relative, problems, use
 
     def _friction_problems(self, normal, use, noise, scale_force) -> list[str]:
         """Pulling contacts, friction without normal force and friction outside its set, at
