@@ -9,7 +9,8 @@ with ``G_i`` the map from contact ``i``'s normal force and friction load ``ℓ``
 to the body wrench about the world origin, ``F_i`` its friction model at unit normal force,
 ``W_j`` the task wrench and ``W_g`` gravity. Force objectives fix ``k_j = 1`` and minimise
 normal forces; the fixed-force objectives find the interval of multiples ``k_j`` held
-(:mod:`fixplan.planner.analysis`). The problem is stacked over all contacts and cases
+(:mod:`fixplan.planner.analysis`), which the analysis of a force objective's forces takes, where
+it can, from the force solve itself (:mod:`fixplan.planner.carried`). The problem is stacked over all contacts and cases
 (:mod:`fixplan.planner.stacking`), compiled once with Parameters for the loads and given forces
 and re-solved with new values (:mod:`fixplan.planner.runner`), verified in numpy
 (:mod:`fixplan.planner.verify`); passive contacts may not squeeze each other
