@@ -393,14 +393,14 @@ class Runner:
         """The map from ``source``'s program to ``check``'s (built once)."""
         key = ("check", False)
         if source not in self._carry:
-            self._carry[source] = Carried.between(
-                self._built[source], self._direct[source], self._built[key], self._direct[key]
-            )
-            if (
-                self._readers.setdefault(key, _Reader.of(self._built[key], self._direct[key]))
-                is None
-            ):
-                self._carry[source] = None  # (its answers are read through cvxpy)
+            if key not in self._readers:
+                self._readers[key] = _Reader.of(self._built[key], self._direct[key])
+            carried = None
+            if self._readers[key] is not None:  # (else its answers are read through cvxpy)
+                carried = Carried.between(
+                    self._built[source], self._direct[source], self._built[key], self._direct[key]
+                )
+            self._carry[source] = carried
         return self._carry[source]
 
     def with_sense(self, objective, wrenches, given, sense, disabled=None) -> dict | None:
