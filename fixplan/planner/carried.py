@@ -12,8 +12,8 @@ constraints are the force program's rows, role by role. So
   shared columns (passive normal forces, friction loads) carries over, as the cost is zero there
   in both programs.
 
-Where the pair is optimal for ``check`` (:func:`~fixplan.planner.optimality.optimal`, checked
-on ``check``'s own data), that end of the interval is 1 without a solve, and for ``k_max`` the
+Where the pair is optimal for ``check`` (:meth:`~fixplan.planner.optimality.Pattern.optimal`,
+checked on ``check``'s own data), that end of the interval is 1 without a solve, and for ``k_max`` the
 multipliers are its impending motion. Which end depends on the sign of ``α``: the forces are
 least where the load pushes the part out (``k_max = 1``) or where it holds the part in
 (``k_min = 1``); the check fails where the given forces hold more than the least (a clamp left at
