@@ -10,10 +10,10 @@ to the body wrench about the world origin, ``F_i`` its friction model at unit no
 ``W_j`` the task wrench and ``W_g`` gravity. Force objectives fix ``k_j = 1`` and minimise
 normal forces; the fixed-force objectives find the interval of multiples ``k_j`` held
 (:mod:`fixplan.planner.analysis`), which the analysis of a force objective's forces takes, where
-it can, from the force solve itself (:mod:`fixplan.planner.carried`). The problem is stacked over all contacts and cases
-(:mod:`fixplan.planner.stacking`), compiled once with Parameters for the loads and given forces
-and re-solved with new values (:mod:`fixplan.planner.runner`), verified in numpy
-(:mod:`fixplan.planner.verify`); passive contacts may not squeeze each other
+it can, from the force solve itself (:mod:`fixplan.planner.carried`). The problem is stacked
+over all contacts and cases (:mod:`fixplan.planner.stacking`), compiled once with Parameters
+for the loads and given forces and re-solved with new values (:mod:`fixplan.planner.runner`),
+verified in numpy (:mod:`fixplan.planner.verify`); passive contacts may not squeeze each other
 (:mod:`fixplan.planner.squeeze`, :mod:`fixplan.planner.unloading`). The dual of the equilibrium
 constraint of a case is the twist in which the body starts to slide; for an infeasible problem
 it is the motion that nothing resists (:mod:`fixplan.planner.certificate`).
