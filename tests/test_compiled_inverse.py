@@ -24,6 +24,9 @@ MOTION_RAD = 1e-9  # ... and the motions to about that angle
 
 rng0 = np.random.default_rng(11)
 CLOUD = rng0.uniform(-0.05, 0.05, size=(300, 2))
+#: The field of benchmarks/bench_limit_surface.py: next to its facets Newton's decrement stalls
+#: on the way into a kink and the compiled path stops there early (STALLED_DECREMENT).
+DENSE_CLOUD = np.random.default_rng(1).uniform(-0.05, 0.05, size=(4096, 2))
 
 #: The shared surfaces the compiled path covers (points, polygons, grids, disks), and more.
 SURFACES = {
@@ -46,6 +49,7 @@ SURFACES = {
     "300 weighted points": lambda: LimitSurface(
         pressure.points(CLOUD, rng0.uniform(0.2, 2.0, len(CLOUD))), mu=0.4, normal_force=80.0
     ),
+    "4,096 points": lambda: LimitSurface(pressure.points(DENSE_CLOUD), mu=0.5, normal_force=100.0),
     "shifted points": lambda: LimitSurface(
         pressure.points([[0.0, 0.0], [0.04, 0.01], [0.01, 0.03]], [2.0, 1.0, 1.5]).shifted(
             0.02, -0.01
