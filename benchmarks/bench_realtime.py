@@ -52,7 +52,7 @@ from performance_rows import emit
 from fixplan.planner.dual_simplex import DualSimplex
 from fixplan.planner.planner import Planner
 from fixplan.planner.problem import Load
-from fixplan.planner.runner import _SOLVER_OPTIONS
+from fixplan.planner.solver_calls import SOLVER_OPTIONS
 
 MODELS = ("ellipsoid", "point-cone", "pyramid")
 
@@ -264,7 +264,7 @@ def _clarabel_steps(matrix, q, equalities, nonneg=None, dimensions=()):
     cones of ``dimensions``."""
     options = clarabel.DefaultSettings()
     options.verbose, options.presolve_enable = False, False
-    for key, value in _SOLVER_OPTIONS["CLARABEL"].items():
+    for key, value in SOLVER_OPTIONS["CLARABEL"].items():
         setattr(options, key, value)
     rows, columns = matrix.shape
     nonneg = rows - equalities if nonneg is None else nonneg

@@ -8,10 +8,11 @@ import numpy as np
 import pytest
 
 from fixplan import pressure
+from fixplan.planner.answers import values_of
 from fixplan.planner.direct_solve import DirectSolver
 from fixplan.planner.planner import Planner
 from fixplan.planner.problem import Body, Contact, Load, Problem
-from fixplan.planner.runner import Runner, _values
+from fixplan.planner.runner import Runner
 from fixplan.planner.stacking import set_given
 
 
@@ -271,7 +272,7 @@ def test_answers_gathered_at_their_positions_are_the_variables_and_given_forces(
         stacked = runner._built[key]
         kept = runner._kept[key]  # (its given forces were written into its vector alone)
         set_given(stacked, dict(kept.given), kept.unit)
-        through_variables = _values(stacked, direct.values())
+        through_variables = values_of(stacked, direct.values())
         for name, value in reader(direct).items():
             np.testing.assert_array_equal(value, through_variables[name], err_msg=name)
         read += 1

@@ -8,15 +8,16 @@ import numpy as np
 import pytest
 from test_dual_simplex import turned_fixture_321
 
+from fixplan.planner.blocks import block_of
 from fixplan.planner.planner import Planner
 from fixplan.planner.problem import Body, Contact, Load, Problem
-from fixplan.planner.runner import Runner, _block_of
+from fixplan.planner.runner import Runner
 
 
 def _block_by_block(self, objective, wrenches, given, order, numbers, sense, disabled, progress):
     """The general path in the lane's place: one block per case, in the lane's order."""
     return [
-        (self._run_block(objective, *_block_of(order[p : p + 1], 1, wrenches, given, None,
+        (self._run_block(objective, *block_of(order[p : p + 1], 1, wrenches, given, None,
                                               numbers), sense, False, disabled), 1)
         for p in range(len(order))
     ]  # fmt: skip

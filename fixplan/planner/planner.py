@@ -41,7 +41,8 @@ from fixplan.planner.problem import (
     Load,
     Problem,
 )
-from fixplan.planner.runner import SOLVERS, Runner
+from fixplan.planner.runner import Runner
+from fixplan.planner.solver_calls import SOLVERS
 from fixplan.planner.squeeze import squeezing
 from fixplan.planner.stacking import REFINE, ContactLayout
 from fixplan.planner.unloading import SqueezeFree

@@ -1,13 +1,14 @@
 """Solving the stacked problems: compiled once, re-solved with new loads, block by block.
 
 A :class:`Runner` keeps one compiled problem per objective. The fixed-force objectives solve
-their load cases (independent, since the active forces are given) in blocks of
-``CASES_PER_BLOCK``, so that one compiled problem serves any number of cases; force objectives
-solve all cases at once. A compiled problem is re-solved straight through Clarabel once cvxpy
+their load cases (independent, since the active forces are given) in blocks
+(:mod:`fixplan.planner.blocks`), so that one compiled problem serves any number of cases; force
+objectives solve all cases at once. A compiled problem is re-solved straight through Clarabel once cvxpy
 has solved it twice (:mod:`fixplan.planner.direct_solve`): re-solves of a force objective with
 new loads, and the blocks of a fixed-force objective after the second. A solver failure retries
-once with a fallback solver; a fixed-force block of several load cases is solved case by case
-instead (the fallback, SCS, is far less accurate).
+once with a fallback solver (:mod:`fixplan.planner.solver_calls`); a fixed-force block of several
+load cases is solved case by case instead (the fallback, SCS, is far less accurate). The answers
+are read and joined by :mod:`fixplan.planner.answers`.
 
 Every block is solved in a force unit of its own, a power of two (which divides without
 rounding) that puts its largest force (the components of the task forces, of the task torques
@@ -21,48 +22,22 @@ answers are not equally good in all of them (its tolerances are partly absolute)
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import cvxpy as cp
 import numpy as np
 
-from fixplan.errors import FixplanError, InvalidArgumentError
+from fixplan.planner.answers import SEVERITY, Reader, in_newtons, joined, merge_blocks, values_of
+from fixplan.planner.blocks import CASES_PER_BLOCK, block_of, similar_order
 from fixplan.planner.carried import Carried, WithoutLoad
 from fixplan.planner.direct_solve import DirectSolver, same_values
 from fixplan.planner.osculating import OsculatingPool, smooth
 from fixplan.planner.parameters import assign
 from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, Problem
-from fixplan.planner.stacking import (
-    REFINE,
-    ContactLayout,
-    Stacked,
-    build,
-    normal_forces,
-    set_given,
-    set_units,
-)
+from fixplan.planner.solver_calls import FALLBACK, SOLVER_OPTIONS, call, uses_dpp
+from fixplan.planner.stacking import ContactLayout, Stacked, build, set_given, set_units
 from fixplan.planner.verify import LARGEST_SCALED_MAGNITUDE
 from fixplan.tolerances import CAPPED_BLOCK_RTOL, CERTIFICATE_RTOL, MAX_SAFETY_FACTOR
-
-SOLVERS = ("CLARABEL", "OSQP", "SCS")
-
-#: Problems whose scalar variables times parameter entries exceed this are compiled without
-#: DPP. cvxpy's DPP compilation builds a map from every parameter entry to the problem data, and
-#: its cost grows with that product: with DPP the first solve costs more and every re-solve less.
-#: On the plate fixture of benchmarks/bench_scaling.py: 200 contacts x 20 cases (15k variables,
-#: 127 parameter entries) 0.25 s then 0.13 s against 0.26 s and 0.15 s without; 50 x 100 (19k,
-#: 607) 0.56 s then 0.27 s against 0.28 s each; 8 x 500 (16k, 3k) peaks at 1.1-2.0 GB. Large
-#: problems are mostly solved once, so there DPP does not pay.
-DPP_MAX_WORK = 5_000_000
-
-#: Load cases per compiled problem of the fixed-force objectives (their cases are independent)
-#: when Clarabel solves them; linear programs go one case at a time through the simplex.
-#: Clarabel's time per case grows with the block, the Python work per block falls: `check` of
-#: 1,000 cases of benchmarks/bench_planner.py through Clarabel, blocks of 1 / 4 / 16 / 64 cases:
-#: fixture-321 (pyramids) 2,276 / 2,359 / 1,728 / 1,195 cases/s; the ellipsoid fixture (blocks
-#: of 1 / 4 / 8 / 64) 3,021 / 3,930 / 3,615 / 3,102 cases/s.
-CASES_PER_BLOCK = 4
 
 #: The largest force of a block in the units it is solved in (see the module). Measured on the
 #: 6-contact exact fixture of tests/test_exact_planner.py with given clamp forces (max-safety-
@@ -72,30 +47,6 @@ CASES_PER_BLOCK = 4
 #: cutting planes, at 4,096 and more too; in newtons (7e4 units) the plate's safety factor came
 #: out 0.966 where 1 holds.
 FORCE_IN_UNITS = 64.0
-
-_FALLBACK = {"CLARABEL": "SCS", "SCS": "CLARABEL", "OSQP": "CLARABEL"}
-#: Clarabel's iterative refinement of the KKT solves is off: it takes about half of the solve
-#: time (a 200-contact x 200-case fixture: 6.5 s with it, 3.5 s without, the same iterations),
-#: and every answer is verified in numpy anyway (a failed verification retries with SCS).
-_SOLVER_OPTIONS = {
-    "CLARABEL": {
-        "tol_gap_abs": 1e-9,
-        "tol_gap_rel": 1e-9,
-        "tol_feas": 1e-9,
-        "iterative_refinement_enable": False,
-    },
-    "SCS": {"eps": 1e-9, "max_iters": 200_000},
-    "OSQP": {"eps_abs": 1e-8, "eps_rel": 1e-8, "max_iter": 50_000, "polish": True},
-}
-_STATUS = {
-    cp.OPTIMAL: "optimal",
-    cp.OPTIMAL_INACCURATE: "inaccurate",
-    cp.INFEASIBLE: "infeasible",
-    cp.INFEASIBLE_INACCURATE: "infeasible",
-    cp.UNBOUNDED: "unbounded",
-    cp.UNBOUNDED_INACCURATE: "unbounded",
-}
-_SEVERITY = ("optimal", "inaccurate", "unbounded", "infeasible", "solver-error")
 
 
 class Runner:
@@ -129,7 +80,7 @@ class Runner:
         self._given: dict[tuple, tuple | None] = {}  # (unit, given forces) last set, if scalars
         self._units: dict[tuple, float] = {}  # the force unit [N] each problem was last set in
         self._kept: dict[tuple, _Kept] = {}  # see _again
-        self._readers: dict[tuple, _Reader | None] = {}  # of the direct solves' answers
+        self._readers: dict[tuple, Reader | None] = {}  # of the direct solves' answers
         #: The key of the program whose direct solve gave the last result (``None``: the last
         #: solve went through cvxpy), and the maps of its optimum into ``check``'s (see
         #: :meth:`carried_ends`, :meth:`held_without_load`).
@@ -223,7 +174,7 @@ class Runner:
             return result
         # One by one (linear programs), the cases go in an order of similar loads, so that
         # each starts the simplex from a nearby basis.
-        order = _similar_order(wrenches) if block == 1 else np.arange(cases)
+        order = similar_order(wrenches) if block == 1 else np.arange(cases)
         scalars = all(isinstance(value, float) for value in given.values())
         if block == 1 and unloaded is None and not accurate and scalars:
             results = self._one_by_one(objective, wrenches, given, order, numbers, sense,
@@ -233,13 +184,13 @@ class Runner:
             for start in range(0, cases, block):
                 index = order[start : min(start + block, cases)]
                 result = self._run_block(
-                    objective, *_block_of(index, block, wrenches, given, unloaded, numbers),
+                    objective, *block_of(index, block, wrenches, given, unloaded, numbers),
                     sense, accurate, disabled,
                 )  # fmt: skip
                 results.append((result, len(index)))
                 if progress is not None:
                     progress(min(start + block, cases), cases)
-        merged = _merge(results)
+        merged = merge_blocks(results)
         if block == 1:  # back to the cases' own order
             back = np.argsort(order)
             for key in ("normal", "friction", "scale", "dual", "known_use"):
@@ -259,7 +210,7 @@ class Runner:
             tried, result = self._again(objective, wrench, given, sense, None, disabled)
             if result is None:
                 result = self._run_block(
-                    objective, *_block_of(order[position : position + 1], 1, wrenches, given,
+                    objective, *block_of(order[position : position + 1], 1, wrenches, given,
                                           None, numbers), sense, False, disabled,
                     direct_failed=tried,
                 )  # fmt: skip
@@ -303,7 +254,7 @@ class Runner:
         if state is None or state != kept.given:
             # Into the vector alone: the Parameters keep the forces that _given names (a solve
             # through cvxpy sets them again where these differ), but where an answer is read
-            # from them (no _Reader).
+            # from them (no Reader).
             through_parameters = self._readers[key] is None
 
             def put(parameter, value):
@@ -367,7 +318,7 @@ class Runner:
         dual = dual.reshape(stacked.balance.shape, order="F")
         result = {"status": "optimal", "solver": "carried from the force solve", "warnings": [],
                   **answer, "dual": dual}  # fmt: skip
-        return _in_newtons(result, kept.unit, key[0])
+        return in_newtons(result, kept.unit, key[0])
 
     def held_without_load(self, wrenches: np.ndarray, given: dict, disabled=None) -> bool:
         """Whether the ``given`` forces and the weight alone are held with no friction, so that
@@ -394,7 +345,7 @@ class Runner:
         key = ("check", False)
         if source not in self._carry:
             if key not in self._readers:
-                self._readers[key] = _Reader.of(self._built[key], self._direct[key])
+                self._readers[key] = Reader.of(self._built[key], self._direct[key])
             carried = None
             if self._readers[key] is not None:  # (else its answers are read through cvxpy)
                 carried = Carried.between(
@@ -464,7 +415,7 @@ class Runner:
         # only without its capped block mates, and then blurs the others in turn); not where
         # only copies of a case reached the cap (padding), which would repeat the same block.
         fewer = np.unique(numbers[again]).size < np.unique(numbers).size
-        block = _block_of(again, len(numbers), wrenches, given, unloaded, numbers)
+        block = block_of(again, len(numbers), wrenches, given, unloaded, numbers)
         if fewer:
             redo = self._run_block(objective, *block, sense, accurate, disabled)
         else:
@@ -476,8 +427,8 @@ class Runner:
         for key in ("normal", "friction", "scale", "dual", "known_use"):
             if result.get(key) is not None and redo.get(key) is not None:
                 result[key][..., again] = redo[key][..., : again.size]
-        result["status"] = max(result["status"], redo["status"], key=_SEVERITY.index)
-        result["solver"] = _joined((result["solver"], redo["solver"]))
+        result["status"] = max(result["status"], redo["status"], key=SEVERITY.index)
+        result["solver"] = joined((result["solver"], redo["solver"]))
         result["warnings"] = list(dict.fromkeys(result["warnings"] + redo["warnings"]))
         return result
 
@@ -492,12 +443,12 @@ class Runner:
         _, first, column = np.unique(numbers, return_index=True, return_inverse=True)
         solved = [
             (self._run_block(
-                objective, *_block_of(first[j : j + 1], len(numbers), wrenches, given, unloaded,
+                objective, *block_of(first[j : j + 1], len(numbers), wrenches, given, unloaded,
                                       numbers), sense, accurate, disabled,
             ), 1)
             for j in range(first.size)
         ]  # fmt: skip
-        merged = _merge(solved)
+        merged = merge_blocks(solved)
         for key in ("normal", "friction", "scale", "dual", "known_use"):
             if merged.get(key) is not None:
                 merged[key] = merged[key][..., np.ravel(column)]
@@ -565,17 +516,17 @@ class Runner:
                 # Settled: the loads meet the exact problem's optimality conditions, checked
                 # here whatever the solver said of its accuracy.
                 solver = f"{self.solver} (osculating ellipsoids)"
-                return _in_newtons(self._result(stacked, "optimal", solver, notes), unit, objective)
+                return in_newtons(self._result(stacked, "optimal", solver, notes), unit, objective)
             solver = self.solver
             if status in ("solver-error", "inaccurate") and not fallback:
                 return {"status": status, "solver": solver, "warnings": notes}
             if status in ("solver-error", "inaccurate"):
-                notes.append(f"{solver} returned {status}; retried with {_FALLBACK[solver]}")
-                solver = _FALLBACK[solver]
+                notes.append(f"{solver} returned {status}; retried with {FALLBACK[solver]}")
+                solver = FALLBACK[solver]
                 status, _ = self._solve(key, stacked, solver, False, notes)
             if exact:
                 solver = f"{solver} (cutting planes)"
-            return _in_newtons(self._result(stacked, status, solver, notes), unit, objective)
+            return in_newtons(self._result(stacked, status, solver, notes), unit, objective)
 
     def _force_unit(self, wrenches: np.ndarray, given: dict) -> float:
         """The force unit [N] of a block with task ``wrenches`` ``(6, K)`` and ``given`` forces:
@@ -627,7 +578,7 @@ class Runner:
     def _result(stacked: Stacked, status: str, solver: str, notes: list) -> dict:
         result = {"status": status, "solver": solver, "warnings": notes}
         if status in ("optimal", "inaccurate"):
-            result.update(_values(stacked))
+            result.update(values_of(stacked))
             if stacked.exact is not None:
                 result["known_use"] = stacked.exact.use.copy()
         if status in ("optimal", "inaccurate", "infeasible"):
@@ -650,7 +601,7 @@ class Runner:
             use, direct = direct and not accurate and solver == self.solver, True
             if use and self._direct_into(key, stacked):
                 return "optimal"
-            status = _call(stacked.problem, solver, accurate=accurate)
+            status = call(stacked.problem, solver, accurate=accurate)
             if status == "optimal" and solver == self.solver:
                 self._prepare_direct(key, stacked)
             return status
@@ -692,15 +643,15 @@ class Runner:
                 return None
             result = {"status": "infeasible", "solver": "CLARABEL (direct)", "warnings": [],
                       "dual": direct.dual(stacked.balance)}  # fmt: skip
-            return _in_newtons(result, unit, key[0])
+            return in_newtons(result, unit, key[0])
         if key not in self._readers:
-            self._readers[key] = _Reader.of(stacked, direct)
+            self._readers[key] = Reader.of(stacked, direct)
         reader = self._readers[key]
-        answer = _values(stacked, direct.values()) if reader is None else reader(direct)
+        answer = values_of(stacked, direct.values()) if reader is None else reader(direct)
         self._source = (key, unit)
         result = {"status": "optimal", "solver": f"{direct.method} (direct)", "warnings": [],
                   **answer, "dual": direct.dual(stacked.balance)}  # fmt: skip
-        return _in_newtons(result, unit, key[0])
+        return in_newtons(result, unit, key[0])
 
     def _prepare_direct(self, key: tuple, stacked: Stacked) -> None:
         """Build the direct solver of an objective after its second cvxpy solve.
@@ -712,11 +663,11 @@ class Runner:
             return
         if key in self._direct or stacked.problem.status != cp.OPTIMAL:
             return
-        if not _uses_dpp(stacked.problem):
+        if not uses_dpp(stacked.problem):
             return
         self._solves[key] = self._solves.get(key, 0) + 1
         if self._solves[key] >= 2:
-            self._direct[key] = DirectSolver.create(stacked.problem, _SOLVER_OPTIONS["CLARABEL"])
+            self._direct[key] = DirectSolver.create(stacked.problem, SOLVER_OPTIONS["CLARABEL"])
 
 
 @dataclass(slots=True)
@@ -746,202 +697,7 @@ def _given_state(given: dict) -> tuple | None:
     return scalars if len(scalars) == len(given) else None
 
 
-#: Up to this many cases are ordered by nearest neighbours (quadratic time); more by angle.
-NEAREST_ORDER_MAX_CASES = 2_000
-
-
-def _similar_order(wrenches: np.ndarray) -> np.ndarray:
-    """An order of the cases in which consecutive task wrenches ``(6, K)`` point in similar
-    directions: greedy nearest neighbours from the first, or for many cases the angle in the
-    plane of their two principal directions. (On 1,000 random milling loads of fixture-321 the
-    simplex then needs a mean of 8.5 pivots per case instead of 21.5.)"""
-    cases = wrenches.shape[1]
-    lengths = np.linalg.norm(wrenches, axis=0)
-    unit = wrenches / np.where(lengths > 0.0, lengths, 1.0)
-    if cases > NEAREST_ORDER_MAX_CASES:
-        basis = np.linalg.svd(unit, full_matrices=False)[0][:, :2]
-        plane = basis.T @ unit
-        return np.argsort(np.arctan2(plane[1], plane[0]), kind="stable")
-    order = np.empty(cases, dtype=np.intp)
-    left = np.ones(cases, dtype=bool)
-    current = 0
-    for position in range(cases):
-        order[position] = current
-        left[current] = False
-        if position + 1 < cases:
-            similarity = np.where(left, unit[:, current] @ unit, -np.inf)
-            current = int(np.argmax(similarity))
-    return order
-
-
-def _block_of(index, size, wrenches, given, unloaded, numbers) -> tuple:
-    """The task wrenches, given forces, unloaded contacts and case numbers of the cases
-    ``index`` (columns of ``wrenches``), padded with copies of the first to ``size`` cases."""
-    padded = np.concatenate([index, np.full(size - len(index), index[0])])
-    cases = wrenches.shape[1]
-    values = {
-        i: v if np.ndim(v) == 0 else np.broadcast_to(v, (cases,))[padded] for i, v in given.items()
-    }
-    mask = None if unloaded is None else unloaded[:, padded]
-    return wrenches[:, padded], values, mask, numbers[padded]
-
-
 def _linear(model) -> bool:
     """Whether a contact's friction set is polyhedral (its program rows are linear)."""
     terms = model.gauge_terms()
     return model.frictionless or (terms is not None and all(k == "max" for k, _ in terms))
-
-
-def _in_newtons(result: dict, unit: float, objective: str) -> dict:
-    """``result`` of a program solved in the force ``unit`` [N], in newtons.
-
-    The equilibrium multipliers scale as the objective over the wrenches: by ``1 / unit`` for
-    the fixed-force objectives (dimensionless multiples) and the squared forces, not at all for
-    the force objectives linear in the forces."""
-    if unit == 1.0:
-        return result
-    for key in ("normal", "friction"):
-        if result.get(key) is not None:
-            result[key] = result[key] * unit
-    if result.get("dual") is not None:
-        objective = objective.removesuffix(REFINE)
-        if objective in FIXED_FORCE_OBJECTIVES or objective == "min-squared-normal-force":
-            result["dual"] = result["dual"] / unit
-    return result
-
-
-def _values(stacked: Stacked, solved: dict | None = None) -> dict:
-    """Normal forces, friction loads and multiples of the last solve: from the cvxpy variables,
-    or from the direct solver's values by variable id (``solved``)."""
-    if solved is None:
-        friction, scale = stacked.friction.value, stacked.scale.value
-    else:
-        friction = solved[stacked.friction.id]
-        scale = stacked.scale.value  # (a constant for force objectives)
-        if isinstance(stacked.scale, cp.Variable):
-            scale = solved[stacked.scale.id]
-    return {
-        "normal": normal_forces(stacked, solved),
-        "friction": np.asarray(friction, dtype=float),
-        "scale": np.ravel(scale).astype(float),
-    }
-
-
-@dataclass(frozen=True, slots=True)
-class _Reader:
-    """Where a direct solve's answer sits, for
-    :meth:`~fixplan.planner.direct_solve.DirectSolver.gather`: the normal forces ``(C, K)``,
-    friction loads ``(D, K)`` and, where they are variables, the multiples ``(K,)``, flattened
-    in that order (``scale``: the constant multiples of a force objective instead); whether all
-    are variables' (``solution_only``: no given normal force read from the parameters). Read so
-    in about 5.5 µs, where the values by variable id take 17."""
-
-    positions: np.ndarray
-    normal_shape: tuple[int, int]
-    friction_shape: tuple[int, int]
-    scale: np.ndarray | None
-    solution_only: bool
-
-    @classmethod
-    def of(cls, stacked: Stacked, direct: DirectSolver) -> _Reader | None:
-        """The reader of ``stacked``'s answer; ``None`` where a part is unknown to ``direct``."""
-        normal = np.full((len(stacked.decided), stacked.task.shape[1]), -1)
-        for index, piece in stacked.normal_parts:
-            found = direct.positions(piece)
-            if found is None:
-                return None
-            normal[index] = found.reshape((len(index), -1), order="F")  # (a clamp's: every case)
-        variables = [stacked.friction]
-        constant = None
-        if isinstance(stacked.scale, cp.Variable):
-            variables.append(stacked.scale)
-        else:
-            constant = np.ravel(stacked.scale.value).astype(float)
-        flat = [normal.ravel()]
-        for variable in variables:
-            found = direct.positions(variable)
-            if found is None:
-                return None
-            flat.append(found.reshape(variable.shape, order="F").ravel())
-        positions = np.concatenate(flat)
-        solution_only = bool(np.all((positions >= 0) & (positions < direct.variables)))
-        return cls(positions, normal.shape, stacked.friction.shape, constant, solution_only)
-
-    def __call__(self, direct: DirectSolver, point: tuple | None = None) -> dict:
-        """Normal forces, friction loads and multiples of ``direct``'s last solve (or of
-        ``point``, an ``x`` of its program and the parameter vector it was found at)."""
-        values = direct.gather(self.positions, solution_only=self.solution_only, point=point)
-        normal_size = self.normal_shape[0] * self.normal_shape[1]
-        friction_end = normal_size + self.friction_shape[0] * self.friction_shape[1]
-        return {
-            "normal": values[:normal_size].reshape(self.normal_shape),
-            "friction": values[normal_size:friction_end].reshape(self.friction_shape),
-            "scale": values[friction_end:] if self.scale is None else self.scale.copy(),
-        }
-
-
-def _uses_dpp(problem: cp.Problem) -> bool:
-    """Whether ``problem`` is small enough for DPP to pay (see ``DPP_MAX_WORK``)."""
-    entries = sum(parameter.size for parameter in problem.parameters())
-    return problem.size_metrics.num_scalar_variables * max(entries, 1) <= DPP_MAX_WORK
-
-
-def _call(problem: cp.Problem, solver: str, *, accurate: bool = False) -> str:
-    large = not _uses_dpp(problem)
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            options = dict(_SOLVER_OPTIONS[solver])
-            if accurate and solver == "CLARABEL":
-                options["iterative_refinement_enable"] = True
-            problem.solve(solver=solver, ignore_dpp=large, **options)
-    except cp.error.SolverError as exc:
-        if solver == "OSQP" and "QP" in str(exc):
-            raise InvalidArgumentError(
-                "solver OSQP handles only LP/QP problems: use pyramid models "
-                "('pyramid', 'point-pyramid') or the default solver CLARABEL"
-            ) from exc
-        return "solver-error"
-    except cp.error.DCPError as exc:  # pragma: no cover - a model broke its contract
-        raise FixplanError(f"internal error: {exc}") from exc
-    return _STATUS.get(problem.status, "solver-error")
-
-
-def _joined(solvers) -> str:
-    """Solver names (each possibly a comma-separated list) as one list without repeats."""
-    return ", ".join(dict.fromkeys(name for names in solvers for name in names.split(", ")))
-
-
-def _merge(results: list[tuple[dict, int]]) -> dict:
-    """One result from the results of consecutive blocks (``(result, cases used)`` pairs)."""
-    if len(results) == 1:
-        result, used = results[0]
-        return _trim(result, used)
-    status = max((r["status"] for r, _ in results), key=_SEVERITY.index)
-    merged = {
-        "status": status,
-        "solver": _joined(r["solver"] for r, _ in results),
-        "warnings": [note for r, _ in results for note in r["warnings"]],
-    }
-    trimmed = [_trim(r, used) for r, used in results]
-    for key in ("normal", "friction", "scale", "dual", "known_use"):
-        parts = [r.get(key) for r in trimmed]
-        if status == "infeasible" and key == "dual":
-            parts = [
-                p if r["status"] == "infeasible" else np.zeros((6, used))
-                for p, r, (_, used) in zip(parts, trimmed, results, strict=True)
-            ]
-        if all(p is not None for p in parts):
-            merged[key] = np.concatenate(parts, axis=-1)
-    return merged
-
-
-def _trim(result: dict, used: int) -> dict:
-    """Drop the padding columns of a block's result."""
-    trimmed = dict(result)
-    for key in ("normal", "friction", "dual", "known_use"):
-        if trimmed.get(key) is not None:
-            trimmed[key] = trimmed[key][:, :used]
-    if "scale" in trimmed:
-        trimmed["scale"] = trimmed["scale"][:used]
-    return trimmed
