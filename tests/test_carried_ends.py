@@ -79,6 +79,56 @@ def test_carried_ends_are_the_reference_held_intervals(model, ends):
     assert found.count("lowest") == len(loads[3:])
 
 
+@pytest.mark.parametrize("model", ["ellipsoid", "pyramid"])
+def test_the_compiled_pass_gives_the_answers_of_its_parts(model, monkeypatch):
+    """Carried.carry_at evaluates the program from its dense maps, carries the optimum and tests
+    the point without load in one compiled pass: the same as the program, the carry and the
+    WithoutLoad test called one by one (the path of programs with sparse maps)."""
+    loads = path(12)
+    problem = bench_fixture(loads[0], model)
+    planner = Planner(problem)
+    for load in loads[:3]:
+        planner.solve(load)
+    runner, key = planner._runner, ("check", False)
+    compared = 0
+    for load in loads[3:]:
+        plan = planner.solve(load, analyse=False)
+        planned = {i: plan.forces[c.name] for i, c in enumerate(problem.contacts)
+                   if c.name in plan.forces}  # fmt: skip
+        wrenches = problem.task_wrenches(load)
+        runner.carried_ends(wrenches, planned)  # (writes check's vector; the pseudo-inverse)
+        source, unit = runner._source
+        carried, direct, without = (
+            runner._carried(source),
+            runner._direct[key],
+            runner._without(key),
+        )
+        kept = runner._kept[key]
+        arguments = (
+            runner._direct[source].solution,
+            unit / kept.unit,
+            kept.vector,
+            direct,
+            without,
+        )
+        assert direct.dense_maps() is not None
+        fused = carried.carry_at(*arguments)
+        with monkeypatch.context() as patch:
+            patch.setattr(type(direct), "dense_maps", lambda self: None)
+            alpha, worst, held, x, z, program = carried.carry_at(*arguments)
+        held = without.held(*program[1:])
+        assert fused[2] == held
+        for mine, theirs in zip(fused[5], program, strict=True):
+            np.testing.assert_allclose(mine, theirs, rtol=1e-14, atol=1e-14)
+        assert fused[0] == pytest.approx(alpha, rel=1e-12)
+        if np.isfinite(worst):
+            assert fused[1] == pytest.approx(worst, rel=1e-6, abs=1e-15)
+            np.testing.assert_allclose(fused[3], x, rtol=1e-14, atol=0)
+            np.testing.assert_allclose(fused[4], z, rtol=1e-12, atol=1e-15)
+        compared += 1
+    assert compared == len(loads[3:])
+
+
 def dissipation_bound(problem, forces, twist):
     """The largest multiple of the task load that ``twist`` allows: the power the contacts can
     take from it (each at most its friction set's, at the given forces) and gravity's, over

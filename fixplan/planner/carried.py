@@ -33,6 +33,7 @@ from fixplan.planner.direct_solve import DirectSolver
 from fixplan.planner.optimality import RESIDUALS, Pattern
 from fixplan.planner.stacking import Stacked
 from fixplan.surface.point_kernel import compiled_scalar
+from fixplan.tolerances import CERTIFICATE_RTOL
 
 
 class Carried:
@@ -109,6 +110,35 @@ class Carried:
         )  # fmt: skip
         return alpha, worst, x, z
 
+    def carry_at(
+        self, solution: tuple[np.ndarray, np.ndarray], ratio: float, vector: np.ndarray,
+        target: DirectSolver, without: WithoutLoad,
+    ) -> tuple:  # fmt: skip
+        """:meth:`carry` into the ``target``'s program at its parameter ``vector``, and with it
+        :meth:`WithoutLoad.held` (``without``: the target's point without load). Returns ``α``,
+        the largest residual, whether the point without load is held (1 or 0; -1 where not
+        tested: ``without`` must first see the program), ``x``, ``z`` and the program
+        ``(q, A's values, b)``.
+
+        Where ``target`` has dense maps (:meth:`~fixplan.planner.direct_solve.DirectSolver.dense_maps`:
+        the small programs of a control loop) all of it is one compiled pass, which evaluates
+        the program itself."""
+        maps = target.dense_maps()
+        if maps is None:
+            q, values, b = target.program(vector)
+            alpha, worst, x, z = self.carry(solution, ratio, q, values, b)
+            return alpha, worst, -1, x, z, (q, values, b)
+        a_map, q_map, split, b_rows = maps
+        pattern = self._pattern
+        x, z = np.zeros(pattern.column_count), np.zeros(pattern.row_count)
+        q, values, b = np.empty(pattern.column_count), np.empty(split), np.zeros(pattern.row_count)
+        alpha, worst, held = _CARRIED_AT(
+            vector, a_map, q_map, split, b_rows, q, values, b, solution[0], solution[1],
+            *self._x, *self._z, ratio, self.multiple, pattern.rows, pattern.indptr,
+            pattern.zero, pattern.nonneg, pattern.heads, pattern.sizes, x, z, *without.pass_data,
+        )  # fmt: skip
+        return alpha, worst, held, x, z, (q, values, b)
+
 
 def _positions(pairs) -> tuple[np.ndarray, np.ndarray]:
     """The entries of ``(target slice, source slice)`` pairs as two index arrays."""
@@ -162,6 +192,51 @@ def carried_pair(
 _CARRIED = compiled_scalar(carried_pair)
 
 
+def carried_at(
+    vector, a_map, q_map, split, b_rows, q, values, b, source_x, source_z, x_target, x_source,
+    z_target, z_source, ratio, multiple, rows, indptr, zero, nonneg, heads, sizes, x, z,
+    entries, found, inverse, passive,
+):  # pragma: no cover - compiled  # fmt: skip
+    """:meth:`Carried.carry_at` with dense maps: the program ``q``, ``values`` (A's) and ``b``
+    (zeros) evaluated at ``vector``, then :func:`carried_pair` and, where A's ``entries`` on
+    the passive columns still hold the values ``found`` that ``inverse`` was made from, the
+    point without load (:meth:`WithoutLoad.held`; its passive columns start at ``passive``).
+    Returns ``α``, the largest residual and whether that point is held (-1: not tested)."""
+    for i in range(a_map.shape[0]):
+        total = 0.0
+        for j in range(vector.shape[0]):
+            total += a_map[i, j] * vector[j]
+        if i < split:
+            values[i] = -total
+        else:
+            b[b_rows[i - split]] = total
+    for i in range(q.shape[0]):
+        total = 0.0
+        for j in range(vector.shape[0]):
+            total += q_map[i, j] * vector[j]
+        q[i] = total
+    alpha, worst = _CARRIED(
+        source_x, source_z, x_target, x_source, z_target, z_source, ratio, multiple, q, values,
+        rows, indptr, b, zero, nonneg, heads, sizes, x, z,
+    )  # fmt: skip
+    if found.shape[0] != entries.shape[0]:
+        return alpha, worst, -1
+    for k in range(entries.shape[0]):
+        if values[entries[k]] != found[k]:
+            return alpha, worst, -1
+    free = np.zeros(x.shape[0])
+    for c in range(inverse.shape[0]):
+        total = 0.0
+        for r in range(zero):
+            total += inverse[c, r] * b[r]
+        free[passive + c] = total
+    primal = RESIDUALS(q, values, rows, indptr, b, free, np.zeros(0), zero, nonneg, heads, sizes)[0]
+    return alpha, worst, 1 if primal <= CERTIFICATE_RTOL else 0
+
+
+_CARRIED_AT = compiled_scalar(carried_at)
+
+
 def _length(rows: slice) -> int:
     return rows.stop - rows.start
 
@@ -191,18 +266,22 @@ class WithoutLoad:
         on_zero = pattern.rows[entries] < pattern.zero
         self._entries = entries[on_zero]
         self._block = (pattern.rows[self._entries], columns[on_zero])
-        self._inverse = (b"", np.zeros((0, pattern.zero)))  # (block values, pseudo-inverse)
+        #: What :func:`carried_at` tests the point with: the block's entries among A's values,
+        #: the values its pseudo-inverse was made from (none yet), that pseudo-inverse and where
+        #: the passive columns start.
+        self.pass_data = (self._entries, np.zeros(0), np.zeros((0, pattern.zero)),
+                          self._passive.start)  # fmt: skip
 
     def held(self, values: np.ndarray, b: np.ndarray) -> bool:
         """Whether that point lies in the cones of the program of ``A``'s ``values`` and ``b``
         (then ``k_min = 0``: the given forces and the weight are held without task load)."""
         found = values[self._entries]
-        key, inverse = self._inverse
-        if found.tobytes() != key:
+        entries, kept, inverse, start = self.pass_data
+        if found.shape != kept.shape or found.tobytes() != kept.tobytes():
             block = np.zeros((self._pattern.zero, self._passive.stop - self._passive.start))
             block[self._block] = found
             inverse = np.linalg.pinv(block)
-            self._inverse = (found.tobytes(), inverse)
+            self.pass_data = (entries, found, inverse, start)
         x = np.zeros(self._pattern.column_count)
         x[self._passive] = inverse @ b[: self._pattern.zero]
         return self._pattern.feasible(values, b, x)

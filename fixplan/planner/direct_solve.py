@@ -249,6 +249,14 @@ class DirectSolver:
         a, b = self._constraints_at(vector)
         return self._program.cost(vector)[0], a, b
 
+    def dense_maps(self) -> tuple | None:
+        """The program as dense maps of the parameter vector, for compiled passes that evaluate
+        it themselves: ``(a_map, q_map, split, b_rows)``, where ``a_map @ vector`` holds minus
+        ``A``'s values (its first ``split`` entries) and then ``b``'s nonzero entries, at rows
+        ``b_rows`` (zeros elsewhere), and ``(q_map @ vector)[:n]`` is ``q``; ``None`` where a
+        map is sparse (large programs) or ``A`` or ``q`` does not depend on the parameters."""
+        return self._program.dense_maps()
+
     def _constraints_at(self, vector: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``A``'s values and ``b`` at ``vector``, kept while the same ``vector`` object holds
         them (:meth:`write` drops them when it puts a parameter of ``A`` or ``b`` into it)."""
@@ -459,6 +467,13 @@ class _Program:
             return self._fixed_cost
         full = self._q.dot(vector)
         return full[: self.variables], float(full[self.variables])
+
+    def dense_maps(self) -> tuple | None:
+        """See :meth:`DirectSolver.dense_maps`."""
+        dense = isinstance(self._a_map, np.ndarray) and isinstance(self._q, np.ndarray)
+        if not dense or self._fixed_values is not None or self._fixed_cost is not None:
+            return None
+        return self._a_map, self._q, self._split, self._a_rows[self._split :]
 
     def constraints(self, vector) -> tuple[np.ndarray, np.ndarray]:
         """Clarabel's ``A`` as its values in the fixed pattern (:meth:`matrix`) and ``b``:

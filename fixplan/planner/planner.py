@@ -93,6 +93,7 @@ class Planner:
         self.length_scale = float(max(spread.max(), 1e-3))
         self._passive = np.array([c.role in PASSIVE_ROLES for c in problem.contacts])
         self._contact_names = tuple(c.name for c in problem.contacts)
+        self._index_of = {name: i for i, name in enumerate(self._contact_names)}
         self._active = ActiveForces(problem.contacts)
         #: The given normal forces [N] by contact index.
         self._given_forces = {
@@ -195,7 +196,7 @@ class Planner:
         if objective in FIXED_FORCE_OBJECTIVES:
             extra = self._intervals(result, wrenches, given, progress, off)
         elif analyse and status == "optimal":
-            planned = {i: f for i, f in self._indexed(forces)}
+            planned = {self._index_of[name]: f for name, f in forces.items()}
             ends = self._carried_ends(wrenches, planned, progress, off)
             if "highest" in ends:  # (the loads verified just now)
                 ends["highest"]["use"] = use
@@ -348,10 +349,6 @@ class Planner:
             f"solution relied on such a squeeze, so these contacts were unloaded: {cases}. "
             "The compliant analysis gives the determinate forces."
         ]
-
-    def _indexed(self, forces):
-        names = {c.name: i for i, c in enumerate(self.problem.contacts)}
-        return [(names[name], value) for name, value in forces.items()]
 
     def _plan(self, status, value, solver, start, notes, fields) -> Plan:
         fields.update(status=status, objective=self.problem.objective, objective_value=value,

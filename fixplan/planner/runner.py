@@ -289,24 +289,29 @@ class Runner:
         kept = self._written(key, wrenches, given, 1.0, None, disabled)
         if kept is None:
             return {}
-        direct = self._direct[key]
-        q, values, b = direct.program(kept.vector)
+        direct, without = self._direct[key], self._without(key)
         ends = {}
         source, unit = self._source or (None, 1.0)
         forces_solved = source is not None and source[0] not in FIXED_FORCE_OBJECTIVES
         carried = self._carried(source) if forces_solved else None
+        held = -1  # (not tested yet)
         if carried is not None:
             solution, ratio = self._direct[source].solution, unit / kept.unit
-            alpha, worst, x, z = carried.carry(solution, ratio, q, values, b)
+            alpha, worst, held, x, z, program = carried.carry_at(
+                solution, ratio, kept.vector, direct, without
+            )
             if alpha < 0.0:  # the other end: the multiple minimised
                 self._sensed(key, -1.0)
-                q = direct.program(kept.vector)[0]
-                alpha, worst, x, z = carried.carry(solution, ratio, q, values, b)
+                alpha, worst, held, x, z, program = carried.carry_at(
+                    solution, ratio, kept.vector, direct, without
+                )
             if worst <= CERTIFICATE_RTOL and kept.sense > 0.0:
                 ends["highest"] = self._carried_result(key, kept, x, z[carried.balance])
             elif worst <= CERTIFICATE_RTOL:
                 ends["lowest"] = {"status": "optimal", "scale": np.ones(1)}
-        if "lowest" not in ends and self._without(key).held(values, b):
+        else:
+            program = direct.program(kept.vector)
+        if "lowest" not in ends and (held == 1 or (held < 0 and without.held(*program[1:]))):
             ends["lowest"] = {"status": "optimal", "scale": np.zeros(1)}
         return ends
 
