@@ -63,23 +63,20 @@ class Screw:
         vx, vy, vz, wx, wy, wz = vx / norm, vy / norm, vz / norm, wx / norm, wy / norm, wz / norm
         speed = math.sqrt(vx * vx + vy * vy + vz * vz)
         spin = math.sqrt(wx * wx + wy * wy + wz * wz)
+        # (One array for all three vectors: each np.array of a list costs about 1 µs.)
         if spin * length_scale <= TRANSLATION_RTOL * speed:
-            return cls(
-                twist=np.array([vx, vy, vz, 0.0, 0.0, 0.0]),
-                direction=np.array([vx / speed, vy / speed, vz / speed]),
-                point=None,
-                pitch=float("inf"),
-                length_scale=length_scale,
-            )
+            values = np.array([vx, vy, vz, 0.0, 0.0, 0.0, vx / speed, vy / speed, vz / speed])
+            return cls(twist=values[:6], direction=values[6:], point=None, pitch=float("inf"),
+                       length_scale=length_scale)  # fmt: skip
         squared = spin * spin  # the point ω × v / |ω|² and the pitch ω·v / |ω|²
-        point = [wy * vz - wz * vy, wz * vx - wx * vz, wx * vy - wy * vx]
-        return cls(
-            twist=np.array([vx, vy, vz, wx, wy, wz]),
-            direction=np.array([wx / spin, wy / spin, wz / spin]),
-            point=np.array([point[0] / squared, point[1] / squared, point[2] / squared]),
-            pitch=(wx * vx + wy * vy + wz * vz) / squared,
-            length_scale=length_scale,
-        )
+        values = np.array([
+            vx, vy, vz, wx, wy, wz, wx / spin, wy / spin, wz / spin,
+            (wy * vz - wz * vy) / squared, (wz * vx - wx * vz) / squared,
+            (wx * vy - wy * vx) / squared,
+        ])  # fmt: skip
+        return cls(twist=values[:6], direction=values[6:9], point=values[9:],
+                   pitch=(wx * vx + wy * vy + wz * vz) / squared,
+                   length_scale=length_scale)  # fmt: skip
 
     @property
     def is_translation(self) -> bool:
