@@ -192,6 +192,27 @@ def carried_pair(
 _CARRIED = compiled_scalar(carried_pair)
 
 
+def held_without_load(
+    values, b, inverse, passive, rows, indptr, zero, nonneg, heads, sizes, columns
+):  # pragma: no cover - compiled
+    """Whether the point of :class:`WithoutLoad` is feasible for the program of ``A``'s
+    ``values`` and ``b`` (``columns`` variables): its passive normal forces (columns from
+    ``passive`` on) are ``inverse`` (the block's pseudo-inverse) times the equality rows of
+    ``b``, everything else 0."""
+    free = np.zeros(columns)
+    for c in range(inverse.shape[0]):
+        total = 0.0
+        for r in range(zero):
+            total += inverse[c, r] * b[r]
+        free[passive + c] = total
+    empty = np.zeros(0)  # (no cost and no multipliers: the primal residual alone)
+    primal = RESIDUALS(empty, values, rows, indptr, b, free, empty, zero, nonneg, heads, sizes)[0]
+    return primal <= CERTIFICATE_RTOL
+
+
+_HELD = compiled_scalar(held_without_load)
+
+
 def carried_at(
     vector, a_map, q_map, split, b_rows, q, values, b, source_x, source_z, x_target, x_source,
     z_target, z_source, ratio, multiple, rows, indptr, zero, nonneg, heads, sizes, x, z,
@@ -224,14 +245,8 @@ def carried_at(
     for k in range(entries.shape[0]):
         if values[entries[k]] != found[k]:
             return alpha, worst, -1
-    free = np.zeros(x.shape[0])
-    for c in range(inverse.shape[0]):
-        total = 0.0
-        for r in range(zero):
-            total += inverse[c, r] * b[r]
-        free[passive + c] = total
-    primal = RESIDUALS(q, values, rows, indptr, b, free, np.zeros(0), zero, nonneg, heads, sizes)[0]
-    return alpha, worst, 1 if primal <= CERTIFICATE_RTOL else 0
+    held = _HELD(values, b, inverse, passive, rows, indptr, zero, nonneg, heads, sizes, x.shape[0])
+    return alpha, worst, 1 if held else 0
 
 
 _CARRIED_AT = compiled_scalar(carried_at)
@@ -282,6 +297,6 @@ class WithoutLoad:
             block[self._block] = found
             inverse = np.linalg.pinv(block)
             self.pass_data = (entries, found, inverse, start)
-        x = np.zeros(self._pattern.column_count)
-        x[self._passive] = inverse @ b[: self._pattern.zero]
-        return self._pattern.feasible(values, b, x)
+        pattern = self._pattern
+        return _HELD(values, b, inverse, start, pattern.rows, pattern.indptr, pattern.zero,
+                     pattern.nonneg, pattern.heads, pattern.sizes, pattern.column_count)  # fmt: skip

@@ -210,9 +210,9 @@ def _newton(kernel, eps2, twist, b1, b2, kinks, current):  # pragma: no cover - 
         if decrement <= INVERSE_RTOL**2 * h:
             return False, h, -1
         if kinks == PROBES and decrement > STALLED_DECREMENT * previous:
-            kink = _kink_at(kernel, twist, STALLED_NEAR_KINK * h)
-            if kink >= 0:
-                return True, h, kink
+            slowest, speed = _slowest_point(kernel, twist)
+            if speed <= STALLED_NEAR_KINK * h:
+                return True, h, slowest
         previous = decrement
         for i in range(3):
             step[i] = s1 * b1[i] + s2 * b2[i]
@@ -253,13 +253,12 @@ def _newton(kernel, eps2, twist, b1, b2, kinks, current):  # pragma: no cover - 
     return True, current[0], -1
 
 
-def _kink_at(kernel, twist, near):  # pragma: no cover - compiled
-    """The support point on whose kink ``twist`` sits (weighted speed at most ``near``), else
-    -1."""
+def _slowest_point(kernel, twist):  # pragma: no cover - compiled
+    """The support point with the least weighted speed under ``twist``, and that speed."""
     index = np.empty(1, dtype=np.int64)
     speed = np.empty(1)
     _slowest(kernel, twist, index, speed)
-    return index[0] if speed[0] <= near else -1
+    return index[0], speed[0]
 
 
 def _slowest(kernel, twist, index, speed):  # pragma: no cover - compiled
@@ -501,15 +500,13 @@ def _solve_load(kernel, discrete, load, units, scale, twist, start, final):  # p
     safety = scale * h
     on_facet = False
     if discrete:
-        index = np.empty(1, dtype=np.int64)
-        speed = np.empty(1)
-        _slowest(kernel, twist, index, speed)
-        if stalled or speed[0] <= NEAR_KINK * h:
+        slowest, speed = _slowest_point(kernel, twist)
+        if stalled or speed <= NEAR_KINK * h:
             safety, on_facet = _facets(kernel, load, scale, twist, safety)
         if stalled or on_facet:
             final[0] = np.nan
         if stalled and not on_facet:
-            certified = _certify_kink(kernel, load, scale, twist, b1, b2, index[0])
+            certified = _certify_kink(kernel, load, scale, twist, b1, b2, slowest)
             if certified > 0.0:
                 return certified, 0.0
             safety = _continuation(kernel, units, scale, twist, safety, b1, b2)
@@ -616,7 +613,7 @@ _projected = compiled_scalar(_projected)
 _newton_step = compiled_scalar(_newton_step)
 _newton = compiled_scalar(_newton)
 _slowest = compiled_scalar(_slowest)
-_kink_at = compiled_scalar(_kink_at)
+_slowest_point = compiled_scalar(_slowest_point)
 _facets = compiled_scalar(_facets)
 _facet = compiled_scalar(_facet)
 _nearest_kink = compiled_scalar(_nearest_kink)
