@@ -27,7 +27,7 @@ def ends(monkeypatch):
 
     def counted(self, *args):
         result = carried(self, *args)
-        found.append(tuple(sorted(result)))
+        found.append(tuple(sorted(set(result) - {"solved"})))  # (solved: not carried)
         return result
 
     def counted_without_load(self, *args):
@@ -215,3 +215,31 @@ def test_switched_off_contacts_are_carried_as_left_out():
         np.testing.assert_allclose(
             plan.held_intervals["cut"], expected.held_intervals["cut"], rtol=INTERVAL_RTOL
         )
+
+
+@pytest.mark.parametrize("model", ["ellipsoid", "pyramid"])
+def test_an_end_not_carried_is_solved_in_the_vector_just_written(model, monkeypatch):
+    """Where the force solve certifies no end (the cut pushes the block into its locators, the
+    clamps idle), ``k_max`` is solved straight in the check program's vector that the carry
+    wrote: the reference's held interval, as the full path finds it."""
+    solved = []
+    carried = Runner.carried_ends
+
+    def recorded(self, *args):
+        result = carried(self, *args)
+        solved.append("solved" in result)
+        return result
+
+    monkeypatch.setattr(Runner, "carried_ends", recorded)
+    loads = path(24)
+    problem = bench_fixture(loads[0], model)
+    planner = Planner(problem)
+    for load in loads[:3]:
+        planner.solve(load)
+    solved.clear()
+    for load in loads[3:]:
+        plan = planner.solve(load)
+        assert plan.status == "optimal"
+        if solved[-1]:
+            assert_interval(plan.held_intervals["cut"], reference_interval(problem, plan, load[0]))
+    assert any(solved)

@@ -112,7 +112,7 @@ def kept_solves(monkeypatch):
 
     def counted_ends(self, *args):
         ends = carried(self, *args)
-        counts["carried"] += len(ends)
+        counts["carried"] += len(set(ends) - {"solved"})  # (solved: not carried)
         return ends
 
     def counted_without_load(self, *args):

@@ -174,6 +174,19 @@ def test_resolving_with_new_loads_reuses_the_compiled_problem():
     assert doubled.objective_value == pytest.approx(2 * first.objective_value, rel=1e-7)
 
 
+@pytest.mark.parametrize("objective", ["min-max-normal-force", "check"])
+def test_a_re_solve_reports_its_analysis_under_the_names_of_its_own_loads(objective):
+    given = {"force": 20.0} if objective == "check" else {}
+    problem = pinch("ellipsoid", load=off_axis_load(), objective=objective, **given)
+    planner = Planner(problem)
+    planner.solve()
+    renamed = [dataclasses.replace(off_axis_load(weight=12.0), name="heavier")]
+    plan = planner.solve(renamed)
+    for field in (plan.safety_factors, plan.held_intervals, plan.held, plan.motions):
+        assert list(field) == ["heavier"]
+    assert plan.load_names == ("heavier",) and plan.critical_load == "heavier"
+
+
 def test_max_safety_factor_scales_the_task_load_not_gravity():
     body = Body(mass=1.0, center_of_mass=[0, 0, 0])
     contacts = [

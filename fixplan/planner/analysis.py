@@ -20,7 +20,6 @@ from __future__ import annotations
 import numpy as np
 
 from fixplan.planner.friction_use import FrictionUse
-from fixplan.planner.problem import Problem
 from fixplan.planner.screw import Screw
 from fixplan.planner.verify import LARGEST_MAGNITUDE
 from fixplan.surface.point_kernel import compiled_scalar
@@ -34,7 +33,8 @@ from fixplan.tolerances import (
 
 
 def analyse_cases(
-    problem: Problem,
+    names: tuple,
+    contact_names: tuple,
     friction_use: FrictionUse,
     staying: StayingInContact,
     highest: dict,
@@ -42,29 +42,32 @@ def analyse_cases(
     wrenches: np.ndarray,
     length_scale: float,
 ) -> dict:
-    """Plan fields from the maximising (``highest``) and minimising (``lowest``) fixed-force
-    solves of every load case; ``staying`` projects the motions onto those that keep the
-    contacts whose normal force the solve chose in contact. ``highest`` may hold the friction
-    use of its loads (``"use"``, already verified), else it is computed here."""
-    names = [load.name for load in problem.loads]
-    k_max = np.array(highest["scale"], dtype=float)
-    k_min = np.zeros_like(k_max) if lowest is None else np.array(lowest["scale"], dtype=float)
-    held = np.empty(len(k_max), dtype=np.bool_)
-    cap = MAX_SAFETY_FACTOR * (1.0 - CAP_RTOL)
-    critical = _MULTIPLES(k_max, k_min, held, cap, MULTIPLE_ATOL, HELD_RTOL)
+    """Plan fields of the load cases ``names`` (those solved, in order) from the maximising
+    (``highest``) and minimising (``lowest``) fixed-force solves of each; ``staying`` projects
+    the motions onto those that keep the contacts whose normal force the solve chose in contact
+    (``contact_names`` in the problem's order). ``highest`` may hold the friction use of its
+    loads (``"use"``, already verified), else it is computed here."""
     normal, friction, dual = highest["normal"], highest["friction"], highest.get("dual")
-    high, low = k_max.tolist(), k_min.tolist()
-    motions = dict.fromkeys(names)
-    if dual is not None:
-        twists, moving = staying(dual, normal, wrenches)
-        for j in range(len(high)):
-            if high[j] < np.inf and moving[j]:
-                motions[names[j]] = Screw.from_twist(twists[:, j], length_scale)
     use = highest.get("use")
     if use is None:
         noise = FRICTION_SET_RTOL * max(LARGEST_MAGNITUDE(normal), 1e-12)
         use = friction_use(friction, normal, noise=noise, known=highest.get("known_use"))
-    utilisation = np.minimum(use, 1.0)
+    cases = len(names)
+    k_max, k_min, held = np.empty(cases), np.empty(cases), np.empty(cases, dtype=np.bool_)
+    utilisation = np.empty(use.shape)
+    critical, contact = _SUMMARY(
+        np.asarray(highest["scale"], dtype=float),
+        _NO_MULTIPLES if lowest is None else np.asarray(lowest["scale"], dtype=float),
+        use, MAX_SAFETY_FACTOR * (1.0 - CAP_RTOL), MULTIPLE_ATOL, HELD_RTOL, k_max, k_min, held,
+        utilisation,
+    )  # fmt: skip
+    high, low = k_max.tolist(), k_min.tolist()
+    motions = dict.fromkeys(names)
+    if dual is not None:
+        twists, moving = staying(dual, normal, wrenches)
+        for j in range(cases):
+            if high[j] < np.inf and moving[j]:
+                motions[names[j]] = Screw.from_twist(twists[:, j], length_scale)
     return {
         "safety_factors": dict(zip(names, high, strict=True)),
         "safety_factor": min(high),
@@ -73,7 +76,7 @@ def analyse_cases(
         "motions": motions,
         "utilisation": utilisation,
         "critical_load": names[critical],
-        "critical_contact": problem.contacts[int(utilisation[:, critical].argmax())].name,
+        "critical_contact": contact_names[contact],
     }
 
 
@@ -189,25 +192,44 @@ def kept_in_contact(
             moving[j] = moving[j] or out[row, j] != 0.0
 
 
-def multiples(k_max, k_min, held, cap, atol, held_rtol):  # pragma: no cover - compiled
-    """Clean the multiples of the two solves in place (solver noise below 0 and below
-    ``atol``, from ``cap`` on as infinity), mark the held cases; the critical case: the first of
-    those tied (within ``held_rtol``) with the smallest margin ``min(k_max, 1 / k_min)``."""
+def summary(
+    highest, lowest, use, cap, atol, held_rtol, k_max, k_min, held, utilisation
+):  # pragma: no cover - compiled
+    """The multiples of the two solves ``highest`` and ``lowest`` (empty: 0 for every case),
+    cleaned into ``k_max`` and ``k_min`` (solver noise below 0 and below ``atol``, from ``cap``
+    on as infinity), the held cases into ``held`` and ``use`` ``(C, K)`` capped at 1 into
+    ``utilisation``. Returns the critical case (the first of those tied within ``held_rtol``
+    with the smallest margin ``min(k_max, 1 / k_min)``) and its most used contact."""
     margins = np.empty(k_max.shape[0])
     for j in range(k_max.shape[0]):
-        high = max(k_max[j], 0.0)  # the solver may return -1e-19 for 0
+        high = max(highest[j], 0.0)  # the solver may return -1e-19 for 0
         k_max[j] = np.inf if high >= cap else high
-        low = max(k_min[j], 0.0)
+        low = max(lowest[j], 0.0) if lowest.shape[0] else 0.0
         k_min[j] = 0.0 if low < atol else low
         margins[j] = min(k_max[j], 1.0 / k_min[j] if k_min[j] > 0.0 else np.inf)
         held[j] = k_min[j] <= 1.0 + held_rtol and k_max[j] >= 1.0 - held_rtol
+    for c in range(use.shape[0]):
+        for j in range(use.shape[1]):
+            utilisation[c, j] = min(use[c, j], 1.0)
     smallest = margins.min()
+    critical = 0
     for j in range(k_max.shape[0]):
         if margins[j] <= smallest * (1.0 + held_rtol):
-            return j
-    return 0
+            critical = j
+            break
+    contact = 0  # (the first of the largest, as argmax; NaN: the first NaN)
+    for c in range(utilisation.shape[0]):
+        value = utilisation[c, critical]
+        if value != value:
+            return critical, c
+        if value > utilisation[contact, critical]:
+            contact = c
+    return critical, contact
 
 
-_MULTIPLES = compiled_scalar(multiples)
+#: The multiples of a missing minimising solve (:func:`summary`).
+_NO_MULTIPLES = np.zeros(0)
+
+_SUMMARY = compiled_scalar(summary)
 _KEPT = compiled_scalar(kept_in_contact)
 _PRESSED = compiled_scalar(pressed_contacts)

@@ -194,17 +194,20 @@ class Planner:
                 warnings.warn(note, stacklevel=2)
         forces = self._active.forces(result["normal"])
         if objective in FIXED_FORCE_OBJECTIVES:
-            extra = self._intervals(result, wrenches, given, progress, off)
+            extra = self._intervals(names, result, wrenches, given, progress, off)
         elif analyse and status == "optimal":
             planned = {self._index_of[name]: f for name, f in forces.items()}
             ends = self._carried_ends(wrenches, planned, progress, off)
-            if "highest" in ends:  # (the loads verified just now)
-                ends["highest"]["use"] = use
-            checked = ends.get("highest") or self._squeeze_free(
-                "check", wrenches, planned, squeezed, progress=progress, disabled=off
-            )
+            if "highest" in ends:  # the force solve's loads, verified just now
+                ends["highest"].update(normal=result["normal"], friction=result["friction"],
+                                       use=use)  # fmt: skip
+            checked = ends.get("highest") or ends.get("solved")
+            if checked is None:
+                checked = self._squeeze_free(
+                    "check", wrenches, planned, squeezed, progress=progress, disabled=off
+                )
             if checked["status"] in ("optimal", "inaccurate"):
-                extra = self._intervals(checked, wrenches, planned, progress, off,
+                extra = self._intervals(names, checked, wrenches, planned, progress, off,
                                         lowest=ends.get("lowest"))  # fmt: skip
             else:
                 notes.append(f"safety analysis of the forces found: {checked['status']}")
@@ -252,26 +255,28 @@ class Planner:
         )
         return refined if refined["status"] == "optimal" else result
 
-    def _intervals(self, highest, wrenches, given, progress, disabled=None, lowest=None) -> dict:
-        """Held intervals, motions and utilisation of the given forces (``highest``: the
-        maximising fixed-force solve; ``lowest``: the minimising one, solved here if ``None``).
-        """
+    def _intervals(
+        self, names, highest, wrenches, given, progress, disabled=None, lowest=None
+    ) -> dict:
+        """Held intervals, motions and utilisation of the given forces in the load cases
+        ``names`` (``highest``: the maximising fixed-force solve; ``lowest``: the minimising one,
+        solved here if ``None``)."""
         if lowest is None:
             lowest = self._lowest(wrenches, given, progress, disabled)
         if lowest["status"] not in ("optimal", "inaccurate"):
             lowest = None
-        return analyse_cases(self.problem, self.friction_use, self._staying, highest, lowest,
-                             wrenches, self.length_scale)  # fmt: skip
+        return analyse_cases(names, self._contact_names, self.friction_use, self._staying,
+                             highest, lowest, wrenches, self.length_scale)  # fmt: skip
 
     def _carried_ends(self, wrenches, given, progress, disabled=None) -> dict:
         """The ends of the held interval of a single load case that the force solve just made
-        certifies for its forces ``given`` (see
+        certifies for its forces ``given``, and its maximising solve where it certifies none (see
         :meth:`~fixplan.planner.runner.Runner.carried_ends`; not with squeezable contacts, whose
         unloading is per solve)."""
         if self.squeeze_contacts:
             return {}
         ends = self._runner.carried_ends(wrenches, given, disabled)
-        if "highest" in ends and progress is not None:
+        if ("highest" in ends or "solved" in ends) and progress is not None:
             progress(1, 1)
         return ends
 

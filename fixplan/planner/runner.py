@@ -280,9 +280,12 @@ class Runner:
         """The ends of the held interval of a single load case (task wrench ``(6, 1)``) at the
         ``given`` forces that need no solve of ``check`` (:mod:`fixplan.planner.carried`):
         ``"highest"`` where the last solve, direct and of a force objective whose forces these
-        are, certifies ``k_max = 1`` (a result as :meth:`run` returns it, with the multipliers),
+        are, certifies ``k_max = 1`` (a result as :meth:`run` returns it, with the multipliers,
+        but for the normal forces and friction loads: those of the force solve),
         ``"lowest"`` where it certifies ``k_min = 1`` or the forces hold the part without task
-        load (``k_min = 0``, :meth:`held_without_load`). Empty where none applies."""
+        load (``k_min = 0``, :meth:`held_without_load`); where ``"highest"`` is not certified,
+        ``"solved"``: the maximising solve of ``check``, direct in the vector just written (where
+        it is optimal). Empty where ``check`` has no kept direct solve for these forces."""
         key = ("check", False)
         if wrenches.shape[1] != 1:
             return {}
@@ -297,33 +300,37 @@ class Runner:
         held = -1  # (not tested yet)
         if carried is not None:
             solution, ratio = self._direct[source].solution, unit / kept.unit
-            alpha, worst, held, x, z, program = carried.carry_at(
+            alpha, worst, held, _, z, program = carried.carry_at(
                 solution, ratio, kept.vector, direct, without
             )
             if alpha < 0.0:  # the other end: the multiple minimised
                 self._sensed(key, -1.0)
-                alpha, worst, held, x, z, program = carried.carry_at(
+                alpha, worst, held, _, z, program = carried.carry_at(
                     solution, ratio, kept.vector, direct, without
                 )
             if worst <= CERTIFICATE_RTOL and kept.sense > 0.0:
-                ends["highest"] = self._carried_result(key, kept, x, z[carried.balance])
+                ends["highest"] = self._carried_result(key, kept, z[carried.balance])
             elif worst <= CERTIFICATE_RTOL:
                 ends["lowest"] = {"status": "optimal", "scale": np.ones(1)}
         else:
             program = direct.program(kept.vector)
         if "lowest" not in ends and (held == 1 or (held < 0 and without.held(*program[1:]))):
             ends["lowest"] = {"status": "optimal", "scale": np.zeros(1)}
+        if "highest" not in ends:
+            # Solved where the vector was just written (the path through run() writes it again
+            # and passes the layers of blocks: about as long as the solve).
+            self._sensed(key, 1.0)
+            solved = self._direct_result(key, self._built[key], kept.vector, kept.unit)
+            if solved is not None and solved["status"] == "optimal":
+                ends["solved"] = solved
         return ends
 
-    def _carried_result(self, key, kept: _Kept, x: np.ndarray, dual: np.ndarray) -> dict:
-        """The result, in newtons, of ``key``'s program at the point ``x`` of its kept
-        parameter vector, with the equilibrium's multipliers ``dual``."""
-        stacked, direct = self._built[key], self._direct[key]
-        answer = self._readers[key](direct, point=(x, kept.vector))
-        dual = dual.reshape(stacked.balance.shape, order="F")
-        result = {"status": "optimal", "solver": "carried from the force solve", "warnings": [],
-                  **answer, "dual": dual}  # fmt: skip
-        return in_newtons(result, kept.unit, key[0])
+    def _carried_result(self, key, kept: _Kept, dual: np.ndarray) -> dict:
+        """The result of ``key``'s program at the carried point: the multiple 1 and the
+        equilibrium's multipliers ``dual`` in newtons (its forces are the force solve's)."""
+        dual = dual.reshape(self._built[key].balance.shape, order="F")
+        return {"status": "optimal", "solver": "carried from the force solve", "warnings": [],
+                "scale": np.ones(1), "dual": dual / kept.unit}  # fmt: skip
 
     def held_without_load(self, wrenches: np.ndarray, given: dict, disabled=None) -> bool:
         """Whether the ``given`` forces and the weight alone are held with no friction, so that
