@@ -309,7 +309,7 @@ class Runner:
                     solution, ratio, kept.vector, direct, without
                 )
             if worst <= CERTIFICATE_RTOL and kept.sense > 0.0:
-                ends["highest"] = self._carried_result(key, kept, z[carried.balance])
+                ends["highest"] = _carried_result(kept, z[carried.balance])
             elif worst <= CERTIFICATE_RTOL:
                 ends["lowest"] = {"status": "optimal", "scale": np.ones(1)}
         else:
@@ -324,13 +324,6 @@ class Runner:
             if solved is not None and solved["status"] == "optimal":
                 ends["solved"] = solved
         return ends
-
-    def _carried_result(self, key, kept: _Kept, dual: np.ndarray) -> dict:
-        """The result of ``key``'s program at the carried point: the multiple 1 and the
-        equilibrium's multipliers ``dual`` in newtons (its forces are the force solve's)."""
-        dual = dual.reshape(self._built[key].balance.shape, order="F")
-        return {"status": "optimal", "solver": "carried from the force solve", "warnings": [],
-                "scale": np.ones(1), "dual": dual / kept.unit}  # fmt: skip
 
     def held_without_load(self, wrenches: np.ndarray, given: dict, disabled=None) -> bool:
         """Whether the ``given`` forces and the weight alone are held with no friction, so that
@@ -695,6 +688,14 @@ class _Kept:
     sense: float
     vector: np.ndarray
     wrenches: np.ndarray
+
+
+def _carried_result(kept: _Kept, dual: np.ndarray) -> dict:
+    """The result of ``check`` (one load case) at the carried point: the multiple 1
+    and the equilibrium's multipliers ``dual`` ``(6,)`` in newtons (its forces are the
+    force solve's)."""
+    return {"status": "optimal", "solver": "carried from the force solve", "warnings": [],
+            "scale": np.array([1.0]), "dual": dual[:, None] / kept.unit}  # fmt: skip
 
 
 def _bytes(disabled: np.ndarray | None) -> bytes | None:
