@@ -187,6 +187,15 @@ def test_a_re_solve_reports_its_analysis_under_the_names_of_its_own_loads(object
     assert plan.load_names == ("heavier",) and plan.critical_load == "heavier"
 
 
+def test_a_re_solve_names_its_own_loads_in_the_certificate():
+    torque = Load(name="twist", force=[0, 0, 0], point=[0, 0, 0], torque=[0, 1.0, 0])
+    planner = Planner(pinch("point-cone", load=torque))
+    plan = planner.solve([dataclasses.replace(torque, name="other twist")])
+    assert plan.status == "infeasible"
+    assert list(plan.infeasible_motions) == ["other twist"]
+    assert "'other twist' cannot be held" in plan.certificate
+
+
 def test_max_safety_factor_scales_the_task_load_not_gravity():
     body = Body(mass=1.0, center_of_mass=[0, 0, 0])
     contacts = [

@@ -97,6 +97,11 @@ def test_each_case_unloads_the_side_locator_that_serves_it_best(case_least_force
     (note,) = [w for w in plan.warnings if "squeeze" in w]
     for load, side in zip(problem.loads, np.argmin(sides, axis=0), strict=True):
         assert f"{load.name!r}: {SIDES[side]};" in note or f"{load.name!r}: {SIDES[side]}." in note
+    # A re-solve with loads of other names names those.
+    renamed = [dataclasses.replace(load, name=f"new {load.name}") for load in problem.loads]
+    (note,) = [w for w in planner.solve(renamed, analyse=False).warnings if "squeeze" in w]
+    for load in renamed:
+        assert f"{load.name!r}: " in note
     # The choices differ between cases: a single unloaded side for all of them costs more.
     worst_single = min(
         max(per_side[side] if per_side[side] is not None else np.inf

@@ -10,17 +10,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from fixplan.planner.problem import Problem
 from fixplan.planner.screw import Screw
 
 
 def certificate(
-    problem: Problem, dual: np.ndarray | None, wrenches: np.ndarray, applied: np.ndarray, *,
+    names: tuple, dual: np.ndarray | None, wrenches: np.ndarray, applied: np.ndarray, *,
     fixed_forces: bool, length_scale: float,
 ) -> tuple[dict, str]:  # fmt: skip
     """The unresisted motion of each load case that cannot be held, and the whole in words.
 
-    ``dual`` ``(6, K)`` is the equilibrium dual of the infeasible solve (``None`` when the
+    ``names`` are the load cases' names; ``dual`` ``(6, K)`` is the equilibrium dual of the infeasible solve (``None`` when the
     solver gave none); ``wrenches`` ``(6, K)`` are the task wrenches and ``applied`` ``(6, K)``
     the wrenches that no contact of the program decides: gravity, the given active forces and,
     for the force objectives, the task loads. The motion is the dual's direction in which they
@@ -31,7 +30,7 @@ def certificate(
         return {}, "the problem is infeasible (the solver gave no certificate)"
     size = np.abs(dual).max()
     motions, lines = {}, []
-    for j, load in enumerate(problem.loads):
+    for j, name in enumerate(names):
         twist = dual[:, j]
         if size == 0.0 or np.abs(twist).max() <= 1e-6 * size:
             continue
@@ -40,7 +39,7 @@ def certificate(
             power = wrenches[:, j] @ twist  # (nothing applied drives it: the task load does)
         twist = twist if power >= 0.0 else -twist
         screw = Screw.from_twist(twist, length_scale)
-        motions[load.name] = screw
+        motions[name] = screw
         cause = (
             " at any multiple of its task load, not even without it (with the given active "
             "forces and the weight)"
@@ -48,7 +47,7 @@ def certificate(
             else ""
         )
         lines.append(
-            f"load case {load.name!r} cannot be held{cause}: nothing resists the motion in which "
+            f"load case {name!r} cannot be held{cause}: nothing resists the motion in which "
             f"the body {screw.describe()}"
         )
     if not lines:

@@ -160,7 +160,7 @@ class Planner:
         given = dict(self._given_forces)
         if off is not None:
             given.update({i: 0.0 for i in given if off[i]})
-        squeezed: dict[str, tuple[str, ...]] = {}
+        squeezed: dict[int, tuple[str, ...]] = {}
         result = self._squeeze_free(
             objective, wrenches, given, squeezed, progress=progress, disabled=off
         )
@@ -172,12 +172,12 @@ class Planner:
         if status == "infeasible":
             fixed = objective in FIXED_FORCE_OBJECTIVES
             motions, words = certificate(
-                self.problem, result.get("dual"), wrenches, self._applied(wrenches, given, fixed),
+                names, result.get("dual"), wrenches, self._applied(wrenches, given, fixed),
                 fixed_forces=fixed, length_scale=self.length_scale,
             )  # fmt: skip
             fields.update(certificate=words, infeasible_motions=motions)
         if status not in ("optimal", "inaccurate"):
-            notes += self._squeeze_notes(squeezed)
+            notes += self._squeeze_notes(squeezed, names)
             return self._plan(status, None, result["solver"], start, notes, fields)
         residual, problems, use = self._verify(result, wrenches)
         if problems and result["solver"].startswith(("CLARABEL", "dual simplex", "interior point")):
@@ -217,7 +217,7 @@ class Planner:
         value = self._active.value(objective, forces, result["scale"])
         if objective in FIXED_FORCE_OBJECTIVES and "safety_factor" in extra:
             value = extra["safety_factor"]
-        notes += self._squeeze_notes(squeezed)
+        notes += self._squeeze_notes(squeezed, names)
         fields.update(
             normal_forces=result["normal"], forces=forces, residual=residual,
             contact_wrenches=self._wrenches(result["normal"], result["friction"]), **extra,
@@ -344,10 +344,14 @@ class Planner:
 
     # -- reporting ----------------------------------------------------------------------------
 
-    def _squeeze_notes(self, squeezed: dict) -> list[str]:
+    def _squeeze_notes(self, squeezed: dict, names: tuple) -> list[str]:
+        """The note on the passive contacts unloaded (``squeezed``: by load case number) in
+        the load cases ``names``."""
         if not squeezed:
             return []
-        cases = "; ".join(f"{case!r}: {', '.join(names)}" for case, names in squeezed.items())
+        cases = "; ".join(
+            f"{names[case]!r}: {', '.join(unloaded)}" for case, unloaded in squeezed.items()
+        )
         return [
             f"passive contacts {', '.join(self.squeeze_contacts)} can squeeze each other "
             "(normal forces that cancel, which no active force or load applies); the rigid "

@@ -63,7 +63,7 @@ class SqueezeFree:
     ):
         """Solve ``objective``, unloading passive contacts until no case holds a squeeze.
 
-        ``squeezed`` collects, per load case name, the contacts unloaded (for the notes);
+        ``squeezed`` collects, per load case number, the contacts unloaded (for the notes);
         ``disabled`` ``(C,)`` bool marks the contacts switched off; ``cases`` numbers the load
         cases of ``wrenches`` among the problem's (default: all, in order).
         """
@@ -93,10 +93,11 @@ class SqueezeFree:
                 found = self._uniform(objective, wrenches, given, members, before, options)
                 if found is not None:
                     result, unloaded = found
-        for j, name in enumerate(load.name for load in self.problem.loads):
+        numbers = range(wrenches.shape[1]) if cases is None else np.asarray(cases).tolist()
+        for j, number in enumerate(numbers):
             found = tuple(n for n, u in zip(passive_names, unloaded[:, j], strict=True) if u)
             if found:
-                squeezed[name] = tuple(dict.fromkeys(squeezed.get(name, ()) + found))
+                squeezed[number] = tuple(dict.fromkeys(squeezed.get(number, ()) + found))
         return result
 
     def _uniform(self, objective, wrenches, given, members, unloaded, options):
