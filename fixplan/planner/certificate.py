@@ -19,12 +19,13 @@ def certificate(
 ) -> tuple[dict, str]:  # fmt: skip
     """The unresisted motion of each load case that cannot be held, and the whole in words.
 
-    ``names`` are the load cases' names; ``dual`` ``(6, K)`` is the equilibrium dual of the infeasible solve (``None`` when the
-    solver gave none); ``wrenches`` ``(6, K)`` are the task wrenches and ``applied`` ``(6, K)``
-    the wrenches that no contact of the program decides: gravity, the given active forces and,
-    for the force objectives, the task loads. The motion is the dual's direction in which they
-    do positive power (the solver's sign is its own); ``fixed_forces``: the active forces were
-    given (then no multiple of the task load, not even 0, is held).
+    ``names`` are the load cases' names; ``dual`` ``(6, K)`` is the equilibrium dual of the
+    infeasible solve (``None`` when the solver gave none); ``wrenches`` ``(6, K)`` are the task
+    wrenches and ``applied`` ``(6, K)`` the wrenches that no contact of the program decides:
+    gravity, the given active forces and, for the force objectives, the task loads. The motion
+    is the dual's direction in which they do positive power (the solver's sign is its own);
+    ``fixed_forces``: the active forces were given (then no multiple of the task load, not even
+    0, is held).
     """
     if dual is None:
         return {}, "the problem is infeasible (the solver gave no certificate)"
