@@ -5,8 +5,9 @@ loaded cell's own four edges.
 Reference: :func:`four_edges_per_cell` builds that kernel here, from the field's cell centres
 and values, with the edge sums of :mod:`~fixplan.surface.polygon_kernel` (a different closed
 form: signed triangles over each edge, where the grid kernel sums an antiderivative over the
-corners). Values, loads and Hessians agree to rounding (:data:`KERNEL_RTOL`). The far-field Gauss
-rule is the same in both.
+corners). Values, loads and Hessians agree to rounding (:data:`KERNEL_RTOL`). The far rule of a
+large grid (blocks of cells, :func:`~fixplan.surface.grid_kernel.block_rule`) is checked against
+a Gauss rule of 6 x 6 points per cell, and integrates polynomials as it should.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import pytest
 from fixplan import LimitSurface, pressure
 from fixplan.surface import limit_surface
 from fixplan.surface.closed_form import EdgeSumKernel, GridKernel
+from fixplan.surface.grid_kernel import BLOCK_NODES, block_rule
 from fixplan.surface.kernels import PosedKernel
 from fixplan.surface.point_kernel import PARALLEL_MIN_WORK, PointSetKernel
 from fixplan.tolerances import FAR_FIELD_RADII, INVERSE_RTOL
@@ -250,7 +252,7 @@ def test_safety_factors_and_motions_match_the_four_edges_per_cell_surface(name, 
 
 
 def test_batches_large_enough_to_run_in_parallel_give_the_one_by_one_answers():
-    # A 120 x 150 Hertz map has about 10,000 loaded corners, each weighed as 4 points: a batch
+    # A 120 x 150 Hertz map has about 10,000 loaded corners, each weighed as 3 points: a batch
     # of 8 queries or Hessians crosses PARALLEL_MIN_WORK and runs on the thread pool. Each
     # twist is computed alone either way, so the answers are the same to the bit.
     surface = LimitSurface(GRIDS["Hertz map of 120 x 150 cells"](), mu=0.5, normal_force=20.0)
@@ -294,3 +296,61 @@ def test_a_grid_placed_away_from_the_origin_is_summed_about_its_middle():
     names = ["value", "load", "Hessian"]
     for what, error in zip(names, errors(reference.size, terms, expected), strict=True):
         assert np.max(error) < 1e-13, f"{what} off by {np.max(error):.1e}"
+
+
+def strip_of_cells(ny: int, nx: int, seed: int) -> pressure.GridField:
+    """A random map (a third of its cells empty) of ``ny x nx`` square cells of 0.1 mm."""
+    rng = np.random.default_rng(seed)
+    values = rng.uniform(0.2, 2.0, (ny, nx))
+    values[rng.random((ny, nx)) < 0.3] = 0.0
+    return pressure.grid(1e-4 * np.arange(nx), 1e-4 * np.arange(ny), values)
+
+
+LARGE_GRIDS = {
+    "Hertz map of 120 x 150 cells": GRIDS["Hertz map of 120 x 150 cells"],
+    "random 61 x 61 with empty cells": lambda: strip_of_cells(61, 61, 21),
+    "strip of 7 x 300 cells": lambda: strip_of_cells(7, 300, 22),
+}
+
+
+@pytest.mark.parametrize("name", LARGE_GRIDS)
+def test_the_far_rule_of_a_large_grid_matches_a_fine_gauss_rule_of_its_cells(name):
+    # At the far-field switch (four sizes), in 36 directions, and for translations: the block
+    # rule against 6 x 6 Gauss points per cell; the 3 x 3 points per cell it replaces are
+    # within 3e-14 there (and the fine rule within rounding of them).
+    field = LARGE_GRIDS[name]()
+    kernel = limit_surface._field_kernel(field)
+    cells = np.count_nonzero(field.values > 0.0)
+    assert len(kernel.far.weights) < 9 * cells / 2  # (under half the points of 3 x 3 per cell)
+    fine = PointSetKernel(*field._local_quadrature(6))
+    angles = np.linspace(0.0, 2.0 * np.pi, 37)[:-1]
+    reach = FAR_FIELD_RADII * kernel.size * 1.0001
+    batch = np.concatenate([
+        np.column_stack([-reach * np.sin(angles), reach * np.cos(angles), -np.ones(36)]),
+        np.column_stack([np.cos(angles), np.sin(angles), np.zeros(36)]),
+    ])  # fmt: skip
+    terms, expected = kernel.newton_terms(batch), fine.newton_terms(batch)
+    for what, error in zip(["value", "load", "Hessian"], errors(fine.size, terms, expected),
+                           strict=True):  # fmt: skip
+        assert np.max(error) < 1e-13, f"{what} off by {np.max(error):.1e}"
+
+
+def test_the_block_rule_integrates_the_pressure_times_low_degree_polynomials_exactly():
+    # 45 x 61 cells in blocks of 3 x 4 (the last block column padded with empty cells): the
+    # moments of x^a y^b, a, b < BLOCK_NODES, against the cells' exact integrals.
+    rng = np.random.default_rng(5)
+    dx, dy = 2e-4, 3e-4
+    corner_x, corner_y = dx * np.arange(62) - 0.006, dy * np.arange(46) - 0.007
+    values = rng.uniform(0.0, 1.0, (45, 61))
+    values[rng.random(values.shape) < 0.3] = 0.0
+    pressure_density = values / (values.sum() * dx * dy)
+    points, weights = block_rule(corner_x, corner_y, pressure_density)
+    scale = 0.01  # [m]: moments of (x / scale)^a (y / scale)^b, of order 1
+    x, y = points[:, 0] / scale, points[:, 1] / scale
+    cx, cy = corner_x / scale, corner_y / scale
+    for a in range(BLOCK_NODES):
+        for b in range(BLOCK_NODES):
+            along_x = (cx[1:] ** (a + 1) - cx[:-1] ** (a + 1)) / (a + 1)
+            along_y = (cy[1:] ** (b + 1) - cy[:-1] ** (b + 1)) / (b + 1)
+            exact = along_y @ pressure_density @ along_x * scale**2
+            assert abs(weights @ (x**a * y**b) - exact) < 1e-14, (a, b)

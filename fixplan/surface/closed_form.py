@@ -176,9 +176,10 @@ class GridKernel(ClosedFormKernel):
 
     ``nodes`` ``(N, 2)`` [m] are corners of the cell lattice with mixed pressure differences
     ``kappa`` ``(N,)`` [1/m²] (:func:`~fixplan.surface.grid_kernel.grid_nodes`; pressures
-    normalised to unit total force), and ``far`` a Gauss rule of the cells for far centres of
+    normalised to unit total force), and ``far`` a point rule of the cells for far centres of
     rotation. Its :attr:`table` ``(3, N)`` holds the nodes' x, y and ``κ``
-    (:func:`~fixplan.surface.grid_kernel.node_terms`).
+    (:func:`~fixplan.surface.grid_kernel.node_terms`); its size is that of its farthest node,
+    the farthest corner of a loaded cell (the far rule's points may lie in empty cells).
     """
 
     nodes: np.ndarray
@@ -190,4 +191,6 @@ class GridKernel(ClosedFormKernel):
     _TERM_WORK = 3  # 8.4-12 ns per node against 2.9-4.2 ns per point, Hessians included
 
     def __post_init__(self):
-        self._store((np.asarray(self.nodes, dtype=float), np.asarray(self.kappa, dtype=float)))
+        nodes = np.asarray(self.nodes, dtype=float)
+        self._store((nodes, np.asarray(self.kappa, dtype=float)))
+        object.__setattr__(self, "_size", float(np.max(np.hypot(nodes[:, 0], nodes[:, 1]))))

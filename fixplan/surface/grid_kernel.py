@@ -21,7 +21,8 @@ costs one square root and two logarithms; the edge sums of
 :mod:`~fixplan.surface.polygon_kernel` cost two square roots and two ``asinh`` per lattice edge,
 and a grid has about twice as many edges as nodes. The support function and its Hessian follow
 from ``M`` as there, and far centres of rotation (where the terms, of size ``R³``, cancel) go to
-the Gauss rule of the cells as there.
+a point rule of the cells as there: on a large grid, that of blocks of cells
+(:func:`block_rule`), which needs a fraction of the points of a Gauss rule per cell.
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numpy.polynomial.legendre import leggauss
 
 from fixplan.surface.point_kernel import compiled_scalar
 from fixplan.surface.polygon_kernel import _SUPPORT_TERMS
@@ -38,6 +40,13 @@ from fixplan.surface.vector_log import _LOGS
 #: terms carrying it (``X A``, ``X² A``, ``X³ A``) are then below ``1e-28 R`` and the quotient
 #: cannot overflow.
 _ON_AXIS = 1e-30
+
+#: The far rule of :func:`block_rule`: blocks of at most ``1 / BLOCKS_PER_SIDE`` of the grid's
+#: cells along each axis, with ``BLOCK_NODES²`` points each. Far centres of rotation are at
+#: least 4 patch sizes away, 80 or more half-blocks: there the rule matches a Gauss rule of 6 x 6
+#: points per cell to rounding (tests/test_grid_kernel.py), as one of 3 x 3 points per cell does.
+BLOCKS_PER_SIDE = 20
+BLOCK_NODES = 6
 
 
 def node_terms(nodes, vx, vy, w, with_hessian, out):  # pragma: no cover - compiled
@@ -101,3 +110,56 @@ def grid_nodes(
     kappa = padded[1:, 1:] + padded[:-1, :-1] - padded[1:, :-1] - padded[:-1, 1:]
     rows, columns = np.nonzero(kappa)
     return np.column_stack([corner_x[columns], corner_y[rows]]), kappa[rows, columns]
+
+
+def block_rule(
+    corner_x: np.ndarray, corner_y: np.ndarray, pressure: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Points ``(n, 2)`` [m] and weights ``(n,)`` integrating the cells' ``pressure``
+    ``(ny, nx)`` [1/m²] (uniform cells between the corners ``corner_x`` ``(nx + 1,)`` and
+    ``corner_y`` ``(ny + 1,)``) times any polynomial of degree below :data:`BLOCK_NODES` in
+    each coordinate over each block of cells exactly: smooth integrands, such as speeds about
+    a far centre of rotation, to the accuracy of the polynomials that interpolate them there.
+
+    The grid is cut into blocks of ``ceil(n / BLOCKS_PER_SIDE)`` cells along each axis of ``n``
+    cells (the last padded with empty cells); a loaded block gets the Gauss-Legendre nodes
+    ``x_k``, ``y_l`` of its sides and the weights ``∫ p L_k(x) L_l(y) dA`` (``L`` the Lagrange
+    polynomials of the nodes), cell by cell in closed form. Weights may be slightly negative;
+    they sum to the total force."""
+    ny, nx = pressure.shape
+    (xs, across_x), (ys, across_y) = (
+        _block_nodes(corner, cells) for corner, cells in ((corner_x, nx), (corner_y, ny))
+    )
+    by, bx = across_y.shape[0], across_x.shape[0]
+    blocks = np.zeros((ys.shape[0] * by, xs.shape[0] * bx))
+    blocks[:ny, :nx] = pressure
+    blocks = blocks.reshape(ys.shape[0], by, xs.shape[0], bx)
+    weights = np.einsum("ak,IaJb,bl->IkJl", across_y, blocks, across_x)
+    loaded = np.broadcast_to(
+        (blocks != 0.0).any(axis=(1, 3))[:, None, :, None], weights.shape
+    )  # fmt: skip
+    x = np.broadcast_to(xs[None, None, :, :], weights.shape)
+    y = np.broadcast_to(ys[:, :, None, None], weights.shape)
+    return np.column_stack([x[loaded], y[loaded]]), weights[loaded]
+
+
+def _block_nodes(corners: np.ndarray, cells: int) -> tuple[np.ndarray, np.ndarray]:
+    """Along one axis of ``cells`` uniform cells between ``corners``: the nodes ``(B, m)`` [m]
+    of its ``B`` blocks of ``b`` cells, and ``∫ L_k`` over each cell of a block ``(b, m)`` [m]."""
+    per_block = -(-cells // BLOCKS_PER_SIDE)
+    count = -(-cells // per_block)
+    width = (corners[-1] - corners[0]) / cells
+    half = 0.5 * per_block * width
+    nodes, gauss = leggauss(BLOCK_NODES)
+    centres = corners[0] + half * (1.0 + 2.0 * np.arange(count))
+    # The basis is of degree BLOCK_NODES - 1: the same Gauss rule on each cell is exact.
+    edges = np.linspace(-1.0, 1.0, per_block + 1)
+    middles, halves = (edges[1:] + edges[:-1]) / 2.0, (edges[1:] - edges[:-1]) / 2.0
+    t = middles[:, None] + halves[:, None] * nodes[None, :]  # (b, q) in block units
+    basis = np.ones((*t.shape, BLOCK_NODES))
+    for k in range(BLOCK_NODES):
+        for j in range(BLOCK_NODES):
+            if j != k:
+                basis[:, :, k] *= (t - nodes[j]) / (nodes[k] - nodes[j])
+    integrals = np.einsum("cq,cqk->ck", halves[:, None] * gauss[None, :], basis) * half
+    return centres[:, None] + half * nodes[None, :], integrals

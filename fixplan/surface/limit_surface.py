@@ -43,7 +43,7 @@ from fixplan.surface.closed_form import EdgeSumKernel, GridKernel
 from fixplan.surface.compiled_inverse import compile_kernel
 from fixplan.surface.disk_kernel import AnnulusKernel, DiskKernel
 from fixplan.surface.geometry import Pose, triangulate
-from fixplan.surface.grid_kernel import grid_nodes
+from fixplan.surface.grid_kernel import block_rule, grid_nodes
 from fixplan.surface.inverse import solve
 from fixplan.surface.kernels import PosedKernel, SumKernel, SupportKernel
 from fixplan.surface.point_kernel import PointSetKernel
@@ -474,8 +474,9 @@ def _cell_squares(field: GridField) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _grid_kernel(field: GridField) -> tuple[GridKernel, np.ndarray]:
-    """The node kernel of a grid, with the cells' Gauss rule for far centres of rotation, and
-    the point ``(2,)`` [m] of the grid's local frame that is its origin.
+    """The node kernel of a grid, with a point rule for far centres of rotation (that of blocks
+    of cells where it has fewer points than a Gauss rule per cell), and the point ``(2,)`` [m]
+    of the grid's local frame that is its origin.
 
     That is the grid's own origin, unless it lies outside the grid (farther from the middle of
     the grid than its corners: a grid not centred, placed away from the contact point): then
@@ -493,9 +494,12 @@ def _grid_kernel(field: GridField) -> tuple[GridKernel, np.ndarray]:
     pressure[field.values > 0.0] = fractions / (dx * dy)
     corner_x = field.x[0] - middle[0] + (np.arange(nx + 1) - 0.5) * dx
     corner_y = field.y[0] - middle[1] + (np.arange(ny + 1) - 0.5) * dy
-    order = 8 if len(centers) <= 16 else 4 if len(centers) <= 256 else 3
-    points, weights = field._local_quadrature(order)
-    far = PointSetKernel(points - middle, weights)
+    points, weights = block_rule(corner_x, corner_y, pressure)
+    if len(centers) <= 256 or len(weights) > 9 * len(centers):  # (a Gauss rule per cell: fewer)
+        order = 8 if len(centers) <= 16 else 4 if len(centers) <= 256 else 3
+        points, weights = field._local_quadrature(order)
+        points = points - middle
+    far = PointSetKernel(points, weights)
     return GridKernel(*grid_nodes(corner_x, corner_y, pressure), far), middle
 
 
