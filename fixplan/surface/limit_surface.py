@@ -494,7 +494,8 @@ def _grid_kernel(field: GridField) -> tuple[GridKernel, np.ndarray]:
     pressure[field.values > 0.0] = fractions / (dx * dy)
     corner_x = field.x[0] - middle[0] + (np.arange(nx + 1) - 0.5) * dx
     corner_y = field.y[0] - middle[1] + (np.arange(ny + 1) - 0.5) * dy
-    points, weights = block_rule(corner_x, corner_y, pressure)
+    if len(centers) > 256:
+        points, weights = block_rule(corner_x, corner_y, pressure)
     if len(centers) <= 256 or len(weights) > 9 * len(centers):  # (a Gauss rule per cell: fewer)
         order = 8 if len(centers) <= 16 else 4 if len(centers) <= 256 else 3
         points, weights = field._local_quadrature(order)
