@@ -11,6 +11,11 @@ problems, each model timed in a fresh process (peak resident memory of that proc
   not settle), with the time per round of a re-solve spent in Clarabel and in moving the
   ellipsoids or cutting (mostly the exact inverse map's queries).
 
+Before them, the exact surface of one of the pinch's grids alone: the median of an evaluation
+with its Hessian and of an inverse-map query, for centres of rotation on the patch (the corner
+sums) and far from it (the far rule of blocks of cells), the far evaluation against a Gauss
+rule of 3 x 3 points per cell (the rule it replaced) in the same run.
+
 The machine is shared and noisy: compare the ratios of the same run.
 """
 
@@ -26,8 +31,9 @@ from pathlib import Path
 
 import numpy as np
 
-from fixplan import Body, Contact, Load, Problem, pressure
+from fixplan import Body, Contact, LimitSurface, Load, Problem, pressure
 from fixplan.planner.planner import Planner
+from fixplan.surface.point_kernel import PointSetKernel
 
 sys.path.insert(0, str(Path(__file__).parent))
 from bench_planner import fixture, milling_loads
@@ -37,11 +43,20 @@ from performance_rows import emit
 RESOLVES = 20
 
 
-def tactile_pinch(model: str, cells: int, loads: list[Load]) -> Problem:
+#: Evaluations and queries timed per kind of centre of rotation on the grid alone.
+GRID_SAMPLES = 30
+
+
+def tactile_patch(cells: int) -> pressure.GridField:
+    """The pinch's Hertz-like map on ``cells x cells`` cells over 20 x 20 mm."""
     side = np.linspace(-0.01, 0.01, cells)
     x, y = np.meshgrid(side, side)
     values = np.sqrt(np.clip(1.0 - (x * x + y * y) / 0.009**2, 0.0, None))
-    patch = pressure.grid(side, side, values)
+    return pressure.grid(side, side, values)
+
+
+def tactile_pinch(model: str, cells: int, loads: list[Load]) -> Problem:
+    patch = tactile_patch(cells)
     contacts = [
         Contact(name=name, role="finger", position=[0, s * 0.03, 0], normal=[0, -s, 0], mu=0.5,
                 model=model, patch=patch)
@@ -114,6 +129,48 @@ def measure(case: str, model: str, cells: int) -> dict:
     }
 
 
+def median_ms(call, arguments) -> float:
+    """Median time [ms] of ``call`` on each of ``arguments``, after one call to warm up."""
+    call(arguments[0])
+    times = []
+    for argument in arguments:
+        start = time.perf_counter()
+        call(argument)
+        times.append(time.perf_counter() - start)
+    return float(np.median(times)) * 1e3
+
+
+def grid_figures(cells: int) -> None:
+    """Evaluations and queries of one pinch grid's exact surface (see the module)."""
+    field = tactile_patch(cells)
+    surface = LimitSurface(field, mu=0.5, normal_force=10.0)
+    kernel = surface._kernel
+    cell_rule = PointSetKernel(*field._local_quadrature(3))
+    rng = np.random.default_rng(0)
+    print(f"exact surface of one {cells} x {cells} grid ({kernel.table.shape[1]:,} loaded corners)")
+    for where, spin in (("on the patch", 300.0), ("far from it", 1.0)):
+        twists = rng.normal(size=(GRID_SAMPLES, 1, 3)) * [1.0, 1.0, spin]
+        loads = surface.load(twists[:, 0]) * rng.uniform(0.5, 1.5, (GRID_SAMPLES, 1))
+        evaluation = median_ms(kernel.newton_terms, twists)
+        query = median_ms(surface.motion_and_safety_factor, loads)
+        line = f"  centres of rotation {where}: evaluation with Hessian {evaluation:.3f} ms"
+        baseline, ratio = "", ""
+        if spin == 1.0:
+            gauss = median_ms(cell_rule.newton_terms, twists)
+            line += (f" ({len(kernel.far.weights):,} points) against {gauss:.3f} ms for 3 x 3 "
+                     f"Gauss points per cell ({len(cell_rule.weights):,})")  # fmt: skip
+            baseline = f"3 × 3 Gauss points per cell: evaluation {gauss:.3f} ms"
+            ratio = f"{gauss / evaluation:.1f}×"
+        print(f"{line}; inverse-map query {query:.3f} ms")
+        emit(
+            f"exact surface of a {cells} × {cells} tactile grid, centres of rotation {where} "
+            "(median): evaluation with Hessian; inverse-map query",
+            f"{evaluation:.3f} ms; {query:.3f} ms",
+            baseline,
+            ratio,
+        )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--cells", type=int, default=200, help="grid side of the pinch")
@@ -122,6 +179,7 @@ def main() -> None:
     if args.child:
         print(json.dumps(measure(*args.child, args.cells)))
         return
+    grid_figures(args.cells)
     for case, title in (
         ("pinch", f"pinch, 2 tactile grids of {args.cells} x {args.cells} cells, 4 load cases"),
         ("fixture", "fixture, 8 area contacts x 20 milling loads (bench_planner.py)"),
