@@ -134,7 +134,7 @@ def block_rule(
     blocks = np.zeros((ys.shape[0] * by, xs.shape[0] * bx))
     blocks[:ny, :nx] = pressure
     blocks = blocks.reshape(ys.shape[0], by, xs.shape[0], bx)
-    weights = np.einsum("ak,IaJb,bl->IkJl", across_y, blocks, across_x)
+    weights = np.einsum("ak,IaJb,bl->IkJl", across_y, blocks, across_x, optimize=True)
     loaded = np.broadcast_to(
         (blocks != 0.0).any(axis=(1, 3))[:, None, :, None], weights.shape
     )  # fmt: skip
