@@ -306,7 +306,17 @@ def strip_of_cells(ny: int, nx: int, seed: int) -> pressure.GridField:
     return pressure.grid(1e-4 * np.arange(nx), 1e-4 * np.arange(ny), values)
 
 
+def small_patch_on_a_large_grid() -> pressure.GridField:
+    """A Hertz disk of 9.5 cells' radius on a 400 x 400 grid of 0.1 mm cells: the blocks must
+    be sized by the loaded cells (whose size sets the far switch), not by the grid."""
+    i = np.arange(400)
+    x, y = np.meshgrid(i, i)
+    values = np.sqrt(np.clip(1.0 - (np.hypot(x - 205, y - 195) / 9.5) ** 2, 0.0, None))
+    return pressure.grid(1e-4 * i, 1e-4 * i, values)
+
+
 LARGE_GRIDS = {
+    "small patch on a 400 x 400 grid": small_patch_on_a_large_grid,
     "Hertz map of 120 x 150 cells": GRIDS["Hertz map of 120 x 150 cells"],
     "random 61 x 61 with empty cells": lambda: strip_of_cells(61, 61, 21),
     "strip of 7 x 300 cells": lambda: strip_of_cells(7, 300, 22),
@@ -316,12 +326,15 @@ LARGE_GRIDS = {
 @pytest.mark.parametrize("name", LARGE_GRIDS)
 def test_the_far_rule_of_a_large_grid_matches_a_fine_gauss_rule_of_its_cells(name):
     # At the far-field switch (four sizes), in 36 directions, and for translations: the block
-    # rule against 6 x 6 Gauss points per cell; the 3 x 3 points per cell it replaces are
-    # within 3e-14 there (and the fine rule within rounding of them).
+    # rule (or, where it has no fewer points, 3 x 3 Gauss points per cell) against 6 x 6 Gauss
+    # points per cell; 3 x 3 points per cell are within 3e-14 there (on the small patch, which
+    # that rule takes: 1.4e-13 on loads and 3.1e-12 on Hessians, its cells being 1/40 of the
+    # switch distance). With blocks sized by the whole 400 x 400 grid, the small patch's
+    # Hessians were 6e-5 off.
     field = LARGE_GRIDS[name]()
     kernel = limit_surface._field_kernel(field)
     cells = np.count_nonzero(field.values > 0.0)
-    assert len(kernel.far.weights) < 9 * cells / 2  # (under half the points of 3 x 3 per cell)
+    assert len(kernel.far.weights) <= 9 * cells
     fine = PointSetKernel(*field._local_quadrature(6))
     angles = np.linspace(0.0, 2.0 * np.pi, 37)[:-1]
     reach = FAR_FIELD_RADII * kernel.size * 1.0001
@@ -330,13 +343,20 @@ def test_the_far_rule_of_a_large_grid_matches_a_fine_gauss_rule_of_its_cells(nam
         np.column_stack([np.cos(angles), np.sin(angles), np.zeros(36)]),
     ])  # fmt: skip
     terms, expected = kernel.newton_terms(batch), fine.newton_terms(batch)
-    for what, error in zip(["value", "load", "Hessian"], errors(fine.size, terms, expected),
-                           strict=True):  # fmt: skip
-        assert np.max(error) < 1e-13, f"{what} off by {np.max(error):.1e}"
+    for what, error, tolerance in zip(["value", "load", "Hessian"],
+                                      errors(fine.size, terms, expected), [2e-13, 2e-13, 5e-12],
+                                      strict=True):  # fmt: skip
+        assert np.max(error) < tolerance, f"{what} off by {np.max(error):.1e}"
+
+
+def test_the_large_grids_far_rule_uses_blocks():
+    hertz = limit_surface._field_kernel(LARGE_GRIDS["Hertz map of 120 x 150 cells"]())
+    cells = np.count_nonzero(hertz_values(120, 150) > 0.0)
+    assert len(hertz.far.weights) < 9 * cells / 5
 
 
 def test_the_block_rule_integrates_the_pressure_times_low_degree_polynomials_exactly():
-    # 45 x 61 cells in blocks of 3 x 4 (the last block column padded with empty cells): the
+    # 45 x 61 cells in blocks of 2 x 3 (the last block row and column padded): the
     # moments of x^a y^b, a, b < BLOCK_NODES, against the cells' exact integrals.
     rng = np.random.default_rng(5)
     dx, dy = 2e-4, 3e-4

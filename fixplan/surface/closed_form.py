@@ -2,7 +2,8 @@
 
 Both sum terms of size ``R³`` (``R`` the distance to the centre of rotation) to a moment
 function of size ``R`` times the patch area, so far centres of rotation (and pure translations)
-go to a Gauss rule of the same field (``far``), beyond
+go to a point rule of the same field (``far``: a Gauss rule, or on a large grid one of blocks of
+cells), beyond
 :data:`~fixplan.tolerances.FAR_FIELD_RADII` sizes of the patch. The terms come from
 :mod:`~fixplan.surface.polygon_kernel` (edges) and :mod:`~fixplan.surface.grid_kernel`
 (corners).
@@ -77,7 +78,7 @@ _NEAR_SUMS = _compiled(_near_sums)
 class ClosedFormKernel(SupportKernel):
     """A kernel summed in closed form over a table (``_table``, of the kind ``_KIND``, read by
     :func:`near_terms`) for centres of rotation within
-    :data:`~fixplan.tolerances.FAR_FIELD_RADII` sizes, and by the Gauss rule ``far`` of the same
+    :data:`~fixplan.tolerances.FAR_FIELD_RADII` sizes, and by the point rule ``far`` of the same
     field beyond (and for pure translations), where the closed-form terms cancel. Subclasses
     declare the fields ``_table`` and ``_size`` (set by :meth:`_store` on construction), the
     cost ``_TERM_WORK`` of one of their terms in points summed, and ``far``."""
@@ -86,7 +87,7 @@ class ClosedFormKernel(SupportKernel):
 
     def _store(self, columns) -> None:
         """Keep the table of ``columns`` (arrays ``(n,)`` or ``(n, k)``, one row per term) and
-        the far rule's size, computed once."""
+        the far rule's size, computed once (a grid kernel then keeps its farthest node's)."""
         object.__setattr__(self, "_table", np.ascontiguousarray(np.column_stack(columns).T))
         object.__setattr__(self, "_size", self.far.size)
 

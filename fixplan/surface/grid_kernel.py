@@ -41,10 +41,11 @@ from fixplan.surface.vector_log import _LOGS
 #: cannot overflow.
 _ON_AXIS = 1e-30
 
-#: The far rule of :func:`block_rule`: blocks of at most ``1 / BLOCKS_PER_SIDE`` of the grid's
-#: cells along each axis, with ``BLOCK_NODES²`` points each. Far centres of rotation are at
-#: least 4 patch sizes away, 80 or more half-blocks: there the rule matches a Gauss rule of 6 x 6
-#: points per cell to rounding (tests/test_grid_kernel.py), as one of 3 x 3 points per cell does.
+#: The far rule of :func:`block_rule`: blocks of ``floor(n / BLOCKS_PER_SIDE)`` (at least 1) of
+#: the ``n`` cells along each axis of the loaded cells' bounding box, with ``BLOCK_NODES²`` points
+#: each. Far centres of rotation are at least 4 patch sizes away, 80 or more half-blocks where
+#: ``n >= BLOCKS_PER_SIDE``: there the rule matches a Gauss rule of 6 x 6 points per cell to
+#: rounding (tests/test_grid_kernel.py), as one of 3 x 3 points per cell does.
 BLOCKS_PER_SIDE = 20
 BLOCK_NODES = 6
 
@@ -121,8 +122,9 @@ def block_rule(
     each coordinate over each block of cells exactly: smooth integrands, such as speeds about
     a far centre of rotation, to the accuracy of the polynomials that interpolate them there.
 
-    The grid is cut into blocks of ``ceil(n / BLOCKS_PER_SIDE)`` cells along each axis of ``n``
-    cells (the last padded with empty cells); a loaded block gets the Gauss-Legendre nodes
+    The grid (the caller passes the loaded cells' bounding box) is cut into blocks of
+    ``floor(n / BLOCKS_PER_SIDE)`` cells (at least 1) along each axis of ``n`` cells (the last
+    padded with empty cells); a loaded block gets the Gauss-Legendre nodes
     ``x_k``, ``y_l`` of its sides and the weights ``∫ p L_k(x) L_l(y) dA`` (``L`` the Lagrange
     polynomials of the nodes), cell by cell in closed form. Weights may be slightly negative;
     they sum to the total force."""
@@ -146,7 +148,7 @@ def block_rule(
 def _block_nodes(corners: np.ndarray, cells: int) -> tuple[np.ndarray, np.ndarray]:
     """Along one axis of ``cells`` uniform cells between ``corners``: the nodes ``(B, m)`` [m]
     of its ``B`` blocks of ``b`` cells, and ``∫ L_k`` over each cell of a block ``(b, m)`` [m]."""
-    per_block = -(-cells // BLOCKS_PER_SIDE)
+    per_block = max(cells // BLOCKS_PER_SIDE, 1)
     count = -(-cells // per_block)
     width = (corners[-1] - corners[0]) / cells
     half = 0.5 * per_block * width
