@@ -298,7 +298,7 @@ def test_a_grid_placed_away_from_the_origin_is_summed_about_its_middle():
         assert np.max(error) < 1e-13, f"{what} off by {np.max(error):.1e}"
 
 
-def strip_of_cells(ny: int, nx: int, seed: int) -> pressure.GridField:
+def random_map(ny: int, nx: int, seed: int) -> pressure.GridField:
     """A random map (a third of its cells empty) of ``ny x nx`` square cells of 0.1 mm."""
     rng = np.random.default_rng(seed)
     values = rng.uniform(0.2, 2.0, (ny, nx))
@@ -318,8 +318,8 @@ def small_patch_on_a_large_grid() -> pressure.GridField:
 LARGE_GRIDS = {
     "small patch on a 400 x 400 grid": small_patch_on_a_large_grid,
     "Hertz map of 120 x 150 cells": GRIDS["Hertz map of 120 x 150 cells"],
-    "random 61 x 61 with empty cells": lambda: strip_of_cells(61, 61, 21),
-    "strip of 7 x 300 cells": lambda: strip_of_cells(7, 300, 22),
+    "random 61 x 61 with empty cells": lambda: random_map(61, 61, 21),
+    "strip of 7 x 300 cells": lambda: random_map(7, 300, 22),
 }
 
 
@@ -356,21 +356,27 @@ def test_the_large_grids_far_rule_uses_blocks():
 
 
 def test_the_block_rule_integrates_the_pressure_times_low_degree_polynomials_exactly():
-    # 45 x 61 cells in blocks of 2 x 3 (the last block row and column padded): the
-    # moments of x^a y^b, a, b < BLOCK_NODES, against the cells' exact integrals.
+    # 45 x 61 cells in blocks of 2 x 3 (the last block row and column padded), and the same
+    # with an empty margin (cut off: blocks of the loaded cells' bounding box): the moments of
+    # x^a y^b, a, b < BLOCK_NODES, against the cells' exact integrals.
     rng = np.random.default_rng(5)
     dx, dy = 2e-4, 3e-4
     corner_x, corner_y = dx * np.arange(62) - 0.006, dy * np.arange(46) - 0.007
     values = rng.uniform(0.0, 1.0, (45, 61))
     values[rng.random(values.shape) < 0.3] = 0.0
+    values[:, 0] = values[0] = 0.5  # (the box is the whole grid)
     pressure_density = values / (values.sum() * dx * dy)
-    points, weights = block_rule(corner_x, corner_y, pressure_density)
+    margin = np.pad(pressure_density, ((3, 5), (7, 2)))
+    wide_x, wide_y = dx * np.arange(-7, 65) - 0.006, dy * np.arange(-3, 51) - 0.007
     scale = 0.01  # [m]: moments of (x / scale)^a (y / scale)^b, of order 1
-    x, y = points[:, 0] / scale, points[:, 1] / scale
     cx, cy = corner_x / scale, corner_y / scale
-    for a in range(BLOCK_NODES):
-        for b in range(BLOCK_NODES):
-            along_x = (cx[1:] ** (a + 1) - cx[:-1] ** (a + 1)) / (a + 1)
-            along_y = (cy[1:] ** (b + 1) - cy[:-1] ** (b + 1)) / (b + 1)
-            exact = along_y @ pressure_density @ along_x * scale**2
-            assert abs(weights @ (x**a * y**b) - exact) < 1e-14, (a, b)
+    rules = [block_rule(corner_x, corner_y, pressure_density), block_rule(wide_x, wide_y, margin)]
+    np.testing.assert_array_equal(rules[1][0], rules[0][0])  # (the same blocks)
+    for points, weights in rules:
+        x, y = points[:, 0] / scale, points[:, 1] / scale
+        for a in range(BLOCK_NODES):
+            for b in range(BLOCK_NODES):
+                along_x = (cx[1:] ** (a + 1) - cx[:-1] ** (a + 1)) / (a + 1)
+                along_y = (cy[1:] ** (b + 1) - cy[:-1] ** (b + 1)) / (b + 1)
+                exact = along_y @ pressure_density @ along_x * scale**2
+                assert abs(weights @ (x**a * y**b) - exact) < 1e-14, (a, b)

@@ -122,12 +122,15 @@ def block_rule(
     each coordinate over each block of cells exactly: smooth integrands, such as speeds about
     a far centre of rotation, to the accuracy of the polynomials that interpolate them there.
 
-    The grid (the caller passes the loaded cells' bounding box) is cut into blocks of
-    ``floor(n / BLOCKS_PER_SIDE)`` cells (at least 1) along each axis of ``n`` cells (the last
-    padded with empty cells); a loaded block gets the Gauss-Legendre nodes
+    The loaded cells' bounding box (whose size, not the grid's, sets the far-field switch) is
+    cut into blocks of ``floor(n / BLOCKS_PER_SIDE)`` cells (at least 1) along each of its axes
+    of ``n`` cells (the last padded with empty cells); a loaded block gets the Gauss-Legendre nodes
     ``x_k``, ``y_l`` of its sides and the weights ``∫ p L_k(x) L_l(y) dA`` (``L`` the Lagrange
     polynomials of the nodes), cell by cell in closed form. Weights may be slightly negative;
     they sum to the total force."""
+    rows, columns = np.flatnonzero(pressure.any(axis=1)), np.flatnonzero(pressure.any(axis=0))
+    pressure = pressure[rows[0] : rows[-1] + 1, columns[0] : columns[-1] + 1]
+    corner_x, corner_y = corner_x[columns[0] : columns[-1] + 2], corner_y[rows[0] : rows[-1] + 2]
     ny, nx = pressure.shape
     (xs, across_x), (ys, across_y) = (
         _block_nodes(corner, cells) for corner, cells in ((corner_x, nx), (corner_y, ny))

@@ -475,8 +475,8 @@ def _cell_squares(field: GridField) -> tuple[np.ndarray, np.ndarray]:
 
 def _grid_kernel(field: GridField) -> tuple[GridKernel, np.ndarray]:
     """The node kernel of a grid, with a point rule for far centres of rotation (that of blocks
-    of its loaded cells where it has fewer points than a Gauss rule per cell), and the point ``(2,)`` [m]
-    of the grid's local frame that is its origin.
+    of its loaded cells where it has fewer points than a Gauss rule per cell), and the point
+    ``(2,)`` [m] of the grid's local frame that is its origin.
 
     That is the grid's own origin, unless it lies outside the grid (farther from the middle of
     the grid than its corners: a grid not centred, placed away from the contact point): then
@@ -494,12 +494,8 @@ def _grid_kernel(field: GridField) -> tuple[GridKernel, np.ndarray]:
     pressure[field.values > 0.0] = fractions / (dx * dy)
     corner_x = field.x[0] - middle[0] + (np.arange(nx + 1) - 0.5) * dx
     corner_y = field.y[0] - middle[1] + (np.arange(ny + 1) - 0.5) * dy
-    if len(centers) > 256:  # (blocks sized by the loaded cells, whose size sets the far switch)
-        rows, columns = np.flatnonzero(pressure.any(axis=1)), np.flatnonzero(pressure.any(axis=0))
-        box = np.s_[rows[0] : rows[-1] + 1, columns[0] : columns[-1] + 1]
-        points, weights = block_rule(
-            corner_x[columns[0] : columns[-1] + 2], corner_y[rows[0] : rows[-1] + 2], pressure[box]
-        )
+    if len(centers) > 256:
+        points, weights = block_rule(corner_x, corner_y, pressure)
     if len(centers) <= 256 or len(weights) >= 9 * len(centers):  # (a Gauss rule per cell: fewer)
         order = 8 if len(centers) <= 16 else 4 if len(centers) <= 256 else 3
         points, weights = field._local_quadrature(order)
