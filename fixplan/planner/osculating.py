@@ -90,15 +90,28 @@ FORCE_DUAL_FLOOR = 1e-6
 PROGRESS = 0.1
 
 #: Tangent-plane cuts per (contact, load case) besides the ellipsoid: each load outside its
-#: exact set leaves the tangent plane at its ray (valid for the exact set), which keeps later
-#: solves from it; new cuts replace the oldest. Without them, loads of contacts that do not limit
-#: the optimum (any of a face of optima) and, far from the optimum, limiting loads too swing
-#: between points outside their sets (on the fixture of benchmarks/bench_exact.py a check block
-#: did not settle in 12 rounds). One slot is not enough there either; each slot costs a row per
-#: contact and case (2 slots: 6.2 ms of Clarabel per round against 2.9 ms without, runs of
-#: their own; one round's program with its cut rows taken out: 3.9 ms and 15 iterations against
-#: 3.1 ms and 14).
+#: exact set leaves the tangent plane at its ray (valid for the exact set), moved out by
+#: ``CUT_SLACK``, which keeps later solves from it; new cuts replace the oldest. Without them,
+#: loads of contacts that do not limit the optimum (any of a face of optima) and, far from the
+#: optimum, limiting loads too swing between points outside their sets (on the fixture of
+#: benchmarks/bench_exact.py a check block did not settle in 12 rounds). One slot is not enough
+#: there either; each slot costs a row per contact and case (2 slots: 6.2 ms of Clarabel per
+#: round against 2.9 ms without, runs of their own; one round's program with its cut rows taken
+#: out: 3.9 ms and 15 iterations against 3.1 ms and 14; both before ``CUT_SLACK``).
 CUT_SLOTS = 2
+
+#: Cuts are placed this fraction beyond the exact set's tangent plane (``L·V <= (1 + CUT_SLACK)
+#: h₁(V)``, still valid). The tangent plane at the point where a pair's next ellipsoid
+#: osculates is tangent to that ellipsoid there too: where the loads settle near that point,
+#: both rows are active with the same normal, which slows the interior point (degenerate
+#: multipliers). The slack keeps the cuts' work, holding loads from swinging far outside,
+#: without that: on the fixture of benchmarks/bench_exact.py (40 re-solves with new loads)
+#: Clarabel took 57.0 iterations and 4.08 rounds per re-solve against 70.3 and 4.33 with tangent
+#: cuts, 472 against 578 with the safety analysis; 60 random problems of
+#: tests/test_osculating_agreement.py's kinds took 887 rounds against 920, with the same two
+#: left to the cutting planes. At 5e-2 the iterations were about the same (56.6), but one of
+#: those problems, whose optimum needs no force, did not settle in 12 rounds.
+CUT_SLACK = 2e-2
 
 #: Ellipsoids are tightened by this fraction (``(1 + MARGIN) ‖R ℓ‖ <= n``), so that the solver's
 #: feasibility error (about 1e-9) does not leave a load outside by more than ``EXACT_CUT_RTOL``.
@@ -230,7 +243,7 @@ class OsculatingPool(ExactContacts):
             normals = exact_normals[outside]
             planes = normals / np.einsum("kc,kc->k", normals, points[outside])[:, None]
             slots = self._next_slot[e, k]
-            self._planes[:, slots, e, k] = planes.T * (1.0 + MARGIN)
+            self._planes[:, slots, e, k] = planes.T / (1.0 + CUT_SLACK)
             self._next_slot[e, k] = (slots + 1) % CUT_SLOTS
         self._assign()
         return settled
