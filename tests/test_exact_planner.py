@@ -387,6 +387,17 @@ def test_an_unpressed_exact_contact_whose_ellipsoid_falls_short_is_not_left_out(
     assert (problem.objective, False) not in planner._runner._built  # settled, no fallback
 
 
+def milling_loads(seed: int) -> list[Load]:
+    """20 random milling loads on the fixture of benchmarks/bench_planner.py."""
+    rng = np.random.default_rng(seed)
+    return [
+        Load(name=f"cut-{k}", force=rng.normal(size=3) * [80.0, 80.0, 40.0],
+             point=[rng.uniform(-0.05, 0.05), rng.uniform(-0.03, 0.03), 0.04],
+             torque=[0.0, 0.0, rng.normal()])
+        for k in range(20)
+    ]  # fmt: skip
+
+
 def test_rounds_slow_to_settle_move_to_the_exact_point_of_the_solves_twist(monkeypatch):
     """Where a load stays outside its exact set after a round, its ellipsoid then osculates
     where the exact normal is the contact's twist (``PROGRESS``): on the 8-contact fixture of
@@ -398,14 +409,7 @@ def test_rounds_slow_to_settle_move_to_the_exact_point_of_the_solves_twist(monke
                         lambda pool: rounds.append(1) or move(pool))  # fmt: skip
 
     def solved(seed):
-        rng = np.random.default_rng(seed)
-        loads = [
-            Load(name=f"cut-{k}", force=rng.normal(size=3) * [80.0, 80.0, 40.0],
-                 point=[rng.uniform(-0.05, 0.05), rng.uniform(-0.03, 0.03), 0.04],
-                 torque=[0.0, 0.0, rng.normal()])
-            for k in range(20)
-        ]  # fmt: skip
-        problem = bench_fixture(loads, "exact")
+        problem = bench_fixture(milling_loads(seed), "exact")
         rounds.clear()
         plan = Planner(problem).solve(analyse=False)
         assert plan.solver == "CLARABEL (osculating ellipsoids)"
@@ -419,7 +423,6 @@ def test_rounds_slow_to_settle_move_to_the_exact_point_of_the_solves_twist(monke
     for (value, _), (expected, _) in zip(anchored, on_rays, strict=True):
         assert value == pytest.approx(expected, rel=OPTIMUM_RTOL)
     assert sum(r for _, r in anchored) < sum(r for _, r in on_rays)
-
 
 
 def counted_clarabel_iterations(monkeypatch) -> list:
@@ -453,22 +456,13 @@ def test_cuts_moved_off_the_tangent_plane_save_interior_point_iterations(monkeyp
     all, and finds the same least clamp forces with every load inside its exact set."""
     iterations = counted_clarabel_iterations(monkeypatch)
 
-    def milling(seed):
-        rng = np.random.default_rng(seed)
-        return [
-            Load(name=f"cut-{k}", force=rng.normal(size=3) * [80.0, 80.0, 40.0],
-                 point=[rng.uniform(-0.05, 0.05), rng.uniform(-0.03, 0.03), 0.04],
-                 torque=[0.0, 0.0, rng.normal()])
-            for k in range(20)
-        ]  # fmt: skip
-
     def solved():
         iterations.clear()
-        problem = bench_fixture(milling(0), "exact")
+        problem = bench_fixture(milling_loads(0), "exact")
         planner = Planner(problem)
         values = []
         for seed in range(4):
-            plan = planner.solve(milling(seed), analyse=False)
+            plan = planner.solve(milling_loads(seed), analyse=False)
             assert plan.solver == "CLARABEL (osculating ellipsoids)"
             assert_loads_inside_their_exact_surfaces(problem, plan)
             values.append(plan.objective_value)
