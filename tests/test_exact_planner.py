@@ -473,3 +473,26 @@ def test_cuts_moved_off_the_tangent_plane_save_interior_point_iterations(monkeyp
     tangent, tangent_iterations = solved()
     np.testing.assert_allclose(moved, tangent, rtol=OPTIMUM_RTOL)
     assert moved_iterations < 0.9 * tangent_iterations, (moved_iterations, tangent_iterations)
+
+
+def test_a_load_stuck_outside_its_exact_set_gets_the_tangent_plane_itself():
+    """A load whose excess a round did not reduce (``PROGRESS``) gets the exact set's tangent
+    plane as its cut, not the plane moved out by ``CUT_SLACK``: along the path of
+    benchmarks/bench_realtime.py (the 8-contact grasp, one case, a cutting load that turns
+    slowly), steps 337 and 338 left a load 2e-7 outside round after round with the moved plane
+    (its ellipsoid, placed at the load's ray, did not bring it in) and went to the cutting
+    planes. Every step up to there must settle in the rounds."""
+    angles = np.linspace(0.0, 4.0 * np.pi, 10_000)[:340]
+    path = [
+        [Load(name="cut", force=[80.0 * np.cos(a), 80.0 * np.sin(a), -30.0],
+              point=[0.02 * np.cos(a / 2), 0.01, 0.04], torque=[0.0, 0.0, 0.8 * np.sin(a)])]
+        for a in angles
+    ]  # fmt: skip
+    problem = bench_fixture(path[0], "exact")
+    planner = Planner(problem)
+    for loads in path[:3]:  # (as the benchmark warms up)
+        planner.solve(loads)
+    for loads in path:
+        plan = planner.solve(loads, analyse=False)
+        assert plan.solver == "CLARABEL (osculating ellipsoids)"
+    assert_loads_inside_their_exact_surfaces(problem, plan)

@@ -101,16 +101,20 @@ PROGRESS = 0.1
 CUT_SLOTS = 2
 
 #: Cuts are placed this fraction beyond the exact set's tangent plane (``L·V <= (1 + CUT_SLACK)
-#: h₁(V)``, still valid). The tangent plane at the point where a pair's next ellipsoid
-#: osculates is tangent to that ellipsoid there too: where the loads settle near that point,
-#: both rows are active with the same normal, which slows the interior point (degenerate
-#: multipliers). The slack keeps the cuts' work, holding loads from swinging far outside,
-#: without that: on the fixture of benchmarks/bench_exact.py (40 re-solves with new loads)
-#: Clarabel took 57.0 iterations and 4.08 rounds per re-solve against 70.3 and 4.33 with tangent
-#: cuts, 472 against 578 with the safety analysis; 60 random problems of
-#: tests/test_osculating_agreement.py's kinds took 887 rounds against 920, with the same two
-#: left to the cutting planes. At 5e-2 the iterations were about the same (56.6), but one of
-#: those problems, whose optimum needs no force, did not settle in 12 rounds.
+#: h₁(V)``, still valid), but for a load whose excess the last round did not reduce by
+#: ``PROGRESS``: that one gets the tangent plane itself. The tangent plane at the point where a
+#: pair's next ellipsoid osculates is tangent to that ellipsoid there too: where the loads settle
+#: near that point, both rows are active with the same normal, which slows the interior point
+#: (degenerate multipliers). Moved out, the cuts still hold loads from swinging far outside: on
+#: the fixture of benchmarks/bench_exact.py (40 re-solves with new loads) Clarabel took 59.1
+#: iterations and 3.98 rounds per re-solve against 70.3 and 4.33 with tangent cuts, 525 against
+#: 578 with the safety analysis; 60 random problems of tests/test_osculating_agreement.py's
+#: kinds took 902 rounds against 920, with the same two left to the cutting planes. A load that
+#: its ellipsoid does not bring in (placed at its ray, on the grasp of bench_realtime.py a load
+#: stayed 2e-7 outside round after round) needs the tangent plane: with every cut moved out, 3
+#: of that grasp's first 500 re-solves went to the cutting planes (none with tangent cuts).
+#: With every cut moved out by 5e-2 the iterations were about the same, but a problem whose
+#: optimum needs no force did not settle in 12 rounds.
 CUT_SLACK = 2e-2
 
 #: Ellipsoids are tightened by this fraction (``(1 + MARGIN) ‖R ℓ‖ <= n``), so that the solver's
@@ -233,7 +237,8 @@ class OsculatingPool(ExactContacts):
         previous = self._previous_excess[owner, cases]
         self._previous_excess[:] = np.nan
         self._previous_excess[owner, cases] = excess
-        slow = beyond & (weights[owner, cases] > 0.0) & (excess >= PROGRESS * previous)
+        stalled = beyond & (excess >= PROGRESS * previous)
+        slow = stalled & (weights[owner, cases] > 0.0)
         moved = self._anchored(factors, twists, owner, cases, slow)
         usable = np.all(np.isfinite(moved), axis=(1, 2))
         self._factors[owner[usable], cases[usable]] = moved[usable] * (1.0 + MARGIN)
@@ -243,7 +248,8 @@ class OsculatingPool(ExactContacts):
             normals = exact_normals[outside]
             planes = normals / np.einsum("kc,kc->k", normals, points[outside])[:, None]
             slots = self._next_slot[e, k]
-            self._planes[:, slots, e, k] = planes.T / (1.0 + CUT_SLACK)
+            scale = np.where(stalled[outside], 1.0 + MARGIN, 1.0 / (1.0 + CUT_SLACK))
+            self._planes[:, slots, e, k] = planes.T * scale
             self._next_slot[e, k] = (slots + 1) % CUT_SLOTS
         self._assign()
         return settled
