@@ -106,10 +106,11 @@ CUT_SLOTS = 2
 #: pair's next ellipsoid osculates is tangent to that ellipsoid there too: where the loads settle
 #: near that point, both rows are active with the same normal, which slows the interior point
 #: (degenerate multipliers). Moved out, the cuts still hold loads from swinging far outside: on
-#: the fixture of benchmarks/bench_exact.py (40 re-solves with new loads) Clarabel took 59.1
-#: iterations and 3.98 rounds per re-solve against 70.3 and 4.33 with tangent cuts, 525 against
-#: 578 with the safety analysis; 60 random problems of tests/test_osculating_agreement.py's
-#: kinds took 902 rounds against 920, with the same two left to the cutting planes. A load that
+#: the fixture of benchmarks/bench_exact.py (90 re-solves with new loads, three planners)
+#: Clarabel took 58.8 iterations and 4.03 rounds per re-solve against 71.3 and 4.39 with tangent
+#: cuts, and 487 against 580 with the safety analysis (20 re-solves); 60 random problems of
+#: tests/test_osculating_agreement.py's kinds took 904 rounds against 920, with the same two left
+#: to the cutting planes. A load that
 #: its ellipsoid does not bring in (placed at its ray, on the grasp of bench_realtime.py a load
 #: stayed 2e-7 outside round after round) needs the tangent plane: with every cut moved out, 3
 #: of that grasp's first 500 re-solves went to the cutting planes (none with tangent cuts).
@@ -322,8 +323,9 @@ def _support(factors: np.ndarray, twists: np.ndarray) -> np.ndarray:
 
 def _normals(factors: np.ndarray, loads: np.ndarray) -> np.ndarray:
     """Outward normals ``RᵀR q`` ``(K, 3)`` of the ellipsoids ``‖R q‖ <= 1`` at the loads'
-    rays (twists, up to their sizes)."""
-    return np.einsum("krc,krd,kd->kc", factors, factors, loads)
+    rays (twists, up to their sizes). (In two products: one einsum of the three operands took
+    5.7× as long on the 157 pairs of a fixture round.)"""
+    return np.einsum("krc,kr->kc", factors, np.einsum("krd,kd->kr", factors, loads))
 
 
 def _chord(first: np.ndarray, second: np.ndarray) -> np.ndarray:
