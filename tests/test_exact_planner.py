@@ -30,6 +30,7 @@ from fixplan import Body, Contact, LimitSurface, Load, Problem, pressure
 from fixplan.planner import osculating as osculating_rounds
 from fixplan.planner import runner
 from fixplan.planner.contact_models import contact_model
+from fixplan.planner.exact_contacts import ExactContacts
 from fixplan.planner.planner import Planner
 from fixplan.tolerances import EXACT_CUT_RTOL, FRICTION_SET_RTOL
 
@@ -496,3 +497,29 @@ def test_a_load_stuck_outside_its_exact_set_gets_the_tangent_plane_itself():
         plan = planner.solve(loads, analyse=False)
         assert plan.solver == "CLARABEL (osculating ellipsoids)"
     assert_loads_inside_their_exact_surfaces(problem, plan)
+
+
+def test_contacts_sharing_a_model_are_queried_together_with_the_same_answers(monkeypatch):
+    """The three pads and the top clamp of the 8-contact fixture of benchmarks/bench_planner.py
+    share one exact model and its jaws another (`contact_models`): the rounds query the
+    loads of each model in one call. The plans, analysis included, are those of one call per
+    contact, to the last bit."""
+    problem = bench_fixture(milling_loads(0)[:4], "exact")
+    new_loads = [milling_loads(seed)[:4] for seed in (1, 2)]
+    together = Planner(problem)
+    assert len({id(model) for model in together.models}) == 2
+    plans = [together.solve(loads) for loads in new_loads]
+
+    def one_call_per_contact(pool, owner):
+        for e in np.unique(owner):
+            yield pool._models[e], np.flatnonzero(owner == e)
+
+    monkeypatch.setattr(ExactContacts, "_by_model", one_call_per_contact)
+    apart = Planner(problem)
+    for plan, loads in zip(plans, new_loads, strict=True):
+        reference = apart.solve(loads)
+        assert plan.solver == reference.solver == "CLARABEL (osculating ellipsoids)"
+        assert plan.objective_value == reference.objective_value
+        np.testing.assert_array_equal(plan.normal_forces, reference.normal_forces)
+        np.testing.assert_array_equal(plan.contact_wrenches, reference.contact_wrenches)
+        assert plan.safety_factors == reference.safety_factors

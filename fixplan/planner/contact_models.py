@@ -6,6 +6,9 @@ and ``mu``), so the torsional friction comes from the patch, never from a guesse
 
 from __future__ import annotations
 
+import pickle
+from collections.abc import Sequence
+
 from fixplan.models import Cone, Ellipsoid, Exact, PointCone, PointPyramid, Pyramid
 from fixplan.models.base import FrictionModel
 from fixplan.planner.problem import DEFAULT_FACETS, DEFAULT_INSCRIBED, Contact
@@ -31,3 +34,33 @@ def contact_model(contact: Contact) -> FrictionModel:
     if model == "pyramid":
         return Pyramid.from_limit_surface(surface, facets=facets, inscribed=inscribed)
     return Exact.from_limit_surface(surface)
+
+
+def contact_models(contacts: Sequence[Contact]) -> list[FrictionModel]:
+    """The friction model of each of ``contacts`` for unit normal force; contacts that ask for
+    the same model of equal patches with the same ``mu`` share one model object (its surface is
+    built once, and the exact rounds query the loads of such contacts together)."""
+    built: dict = {}
+    models = []
+    for contact in contacts:
+        key = _model_key(contact)
+        if key is None:
+            models.append(contact_model(contact))
+            continue
+        if key not in built:
+            built[key] = contact_model(contact)
+        models.append(built[key])
+    return models
+
+
+def _model_key(contact: Contact) -> tuple | None:
+    """What decides a contact's named model: the name, ``mu``, the pyramid's settings and the
+    patch (its pickled fields: equal patches give equal bytes); ``None`` for a model object or
+    a patch that does not pickle."""
+    if not isinstance(contact.model, str):
+        return None
+    try:
+        patch = pickle.dumps(contact.patch, protocol=pickle.HIGHEST_PROTOCOL)
+    except (pickle.PicklingError, AttributeError, TypeError):
+        return None
+    return (contact.model, float(contact.mu), contact.facets, contact.inscribed, patch)

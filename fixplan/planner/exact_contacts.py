@@ -58,6 +58,11 @@ class ExactContacts:
     ):
         self._contacts = np.array(sorted(models), dtype=int)
         self._models = [models[i] for i in self._contacts]
+        #: The distinct model objects (contacts may share one: see
+        #: :func:`~fixplan.planner.contact_models.contact_models`) and each contact's among them.
+        distinct = {id(model): model for model in self._models}
+        self._distinct = list(distinct.values())
+        self._model_of = np.array([list(distinct).index(id(m)) for m in self._models], dtype=int)
         self._rows = np.array([np.arange(slices[i].start, slices[i].stop) for i in self._contacts])
         self._normal, self._friction, self._balance = normal, friction, balance
         self._normal_parts = normal_parts
@@ -85,6 +90,14 @@ class ExactContacts:
         """The pool of the exact models among ``models`` (one per contact), or ``None``."""
         exact = {i: m for i, m in enumerate(models) if isinstance(m, Exact) and not m.frictionless}
         return cls(exact, slices, normal, friction, **options) if exact else None
+
+    def _by_model(self, owner: np.ndarray):
+        """``(model, rows)`` per distinct model of the exact contacts ``owner`` ``(P,)``: the rows
+        of ``owner`` whose contact has that model, in order (their loads are queried in one
+        call)."""
+        which = self._model_of[owner]
+        for index in np.unique(which):
+            yield self._distinct[index], np.flatnonzero(which == index)
 
     def _normal_values(self) -> np.ndarray:
         """``(C, K)`` normal forces [N] of the last solve."""

@@ -218,12 +218,10 @@ class OsculatingPool(ExactContacts):
         # The normals of the ellipsoids the solve used, at its loads: the exact sliding twists
         # near the optimum (stationarity), where the inverse map starts.
         used = _normals(self._factors[owner, cases], per_unit)
-        found = [
-            model.osculating(per_unit[owner == e], used[owner == e])
-            for e, model in enumerate(self._models)
-            if moving[e].any()
-        ]
-        excess, points, factors = (np.concatenate(part) for part in zip(*found, strict=True))
+        excess, points = np.empty(owner.size), np.empty((owner.size, 3))
+        factors = np.empty((owner.size, 3, 3))
+        for model, rows in self._by_model(owner):
+            excess[rows], points[rows], factors[rows] = model.osculating(per_unit[rows], used[rows])
         self.use[self._contacts[owner], cases] = 1.0 + excess
         exact_normals = _normals(factors, points)
         limiting = weights[owner, cases] > 0.0  # (a NaN normal elsewhere does not matter)
@@ -262,10 +260,11 @@ class OsculatingPool(ExactContacts):
         if not slow.any():
             return factors
         factors = factors.copy()
-        for e in np.unique(owner[slow]):
-            rows = np.flatnonzero(slow & (owner == e))
-            load_twists = twists[e, cases[rows]] / self._units[e]
-            found = self._models[e].osculating_at(load_twists)[1]
+        chosen = np.flatnonzero(slow)
+        for model, part in self._by_model(owner[chosen]):
+            rows = chosen[part]
+            load_twists = twists[owner[rows], cases[rows]] / self._units[owner[rows]]
+            found = model.osculating_at(load_twists)[1]
             finite = np.all(np.isfinite(found), axis=(1, 2))
             factors[rows[finite]] = found[finite]
         return factors
@@ -290,19 +289,19 @@ class OsculatingPool(ExactContacts):
         if owner.size == 0:
             return True
         loose = np.zeros(owner.size, dtype=bool)
-        for e in np.unique(owner):
-            rows = np.flatnonzero(owner == e)
-            model = self._models[e]
-            twist = twists[e, cases[rows]] / self._units[e]  # load-space twists
-            reach = _support(self._factors[e, cases[rows]], twist)
+        for model, rows in self._by_model(owner):
+            e, k = owner[rows], cases[rows]
+            twist = twists[e, k] / self._units[e]  # load-space twists
+            reach = _support(self._factors[e, k], twist)
             exact = model.surface.support(twist) / model.surface.normal_force
-            loose[rows] = weights[e, cases[rows]] * (1.0 - reach / exact) > SUPPORT_RTOL
+            loose[rows] = weights[e, k] * (1.0 - reach / exact) > SUPPORT_RTOL
             if loose[rows].any():
                 short = rows[loose[rows]]
                 points = model.surface.load(twist[loose[rows]]) / model.surface.normal_force
                 found = model.osculating(points)[2]
-                usable = np.all(np.isfinite(found), axis=(1, 2))
-                self._factors[e, cases[short[usable]]] = found[usable] * (1.0 + MARGIN)
+                finite = np.all(np.isfinite(found), axis=(1, 2))
+                usable = short[finite]
+                self._factors[owner[usable], cases[usable]] = found[finite] * (1.0 + MARGIN)
         return not loose.any()
 
     def _assign(self) -> None:

@@ -30,7 +30,7 @@ import numpy as np
 from fixplan.errors import InvalidArgumentError
 from fixplan.planner.analysis import StayingInContact, analyse_cases
 from fixplan.planner.certificate import certificate
-from fixplan.planner.contact_models import contact_model
+from fixplan.planner.contact_models import contact_models
 from fixplan.planner.friction_use import FrictionUse
 from fixplan.planner.objectives import ActiveForces
 from fixplan.planner.plan import Plan
@@ -85,7 +85,7 @@ class Planner:
             )
         self.problem = problem
         self.solver = solver
-        self.models = [contact_model(c) for c in problem.contacts]
+        self.models = contact_models(problem.contacts)
         self.layout = ContactLayout.of(problem, self.models)
         self.friction_use = FrictionUse(self.models, self.layout.slices)
         positions = np.array([c.position for c in problem.contacts])
