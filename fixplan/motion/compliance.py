@@ -70,7 +70,7 @@ from fixplan.motion.contact_springs import (
     WrongContactSetError,
 )
 from fixplan.motion.load_ramp import LoadRamp, State
-from fixplan.planner.contact_models import contact_model
+from fixplan.planner.contact_models import contact_models
 from fixplan.planner.plan import Plan
 from fixplan.planner.problem import PASSIVE_ROLES, Contact, Problem
 from fixplan.tolerances import MAX_SAFETY_FACTOR
@@ -238,7 +238,7 @@ def analyse(
     gravity = _about(problem.body.weight_wrench[:, None], centre)[:, 0]
     tasks = list(_about(problem.task_wrenches(), centre).T)
     preloads = [_preloads(problem, forces, index) for index in range(len(problem.loads))]
-    models = [contact_model(c) for c in contacts]
+    models = contact_models(contacts)
     scale = max(np.abs(np.r_[gravity[:3], np.ravel(preloads), np.ravel(tasks)]).max(), 1.0)
     # Clamping: the active contacts push with their preloads (an external wrench) and carry
     # nothing else. Task: a clamp's normal force stays at its preload (force-controlled).

@@ -20,7 +20,7 @@ import cvxpy as cp
 import numpy as np
 
 from fixplan.errors import FixplanError, InvalidArgumentError
-from fixplan.planner.contact_models import contact_model
+from fixplan.planner.contact_models import contact_models
 from fixplan.planner.problem import Contact
 from fixplan.surface.sphere import circle, fibonacci_sphere
 
@@ -63,7 +63,7 @@ class ContactSetSurface:
         self.normal_forces = forces
         self.subspace = tuple(subspace)
         select = np.array([np.eye(6)[COMPONENTS.index(c)] for c in subspace])
-        models = [contact_model(c) for c in contacts]
+        models = contact_models(contacts)
         parts = []
         for contact, model in zip(contacts, models, strict=True):
             parts.append(select @ contact.wrench_basis()[:, 1 : 1 + model.load_dimension])

@@ -237,7 +237,7 @@ def dual_pivots(a, b, q, equalities, rows, inverse, x, z, limit, feasibility, op
     for k in range(n):
         active[rows[k]] = True
     # (The products with B^-1 run along its rows, contiguous in memory, so that they vectorise:
-    # 31 % less time than along its columns on the solves of a check of fixture-321.)
+    # a third less time than along its columns on the solves of a check of fixture-321.)
     z_rows, d, b_rows = np.empty(n), np.empty(n), np.empty(n)
     pivots, since = 0, 0
     while True:

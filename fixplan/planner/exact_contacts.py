@@ -60,9 +60,9 @@ class ExactContacts:
         self._models = [models[i] for i in self._contacts]
         #: The distinct model objects (contacts may share one: see
         #: :func:`~fixplan.planner.contact_models.contact_models`) and each contact's among them.
-        distinct = {id(model): model for model in self._models}
-        self._distinct = list(distinct.values())
-        self._model_of = np.array([list(distinct).index(id(m)) for m in self._models], dtype=int)
+        index: dict[int, int] = {}
+        self._model_of = np.array([index.setdefault(id(m), len(index)) for m in self._models])
+        self._distinct = list({id(m): m for m in self._models}.values())
         self._rows = np.array([np.arange(slices[i].start, slices[i].stop) for i in self._contacts])
         self._normal, self._friction, self._balance = normal, friction, balance
         self._normal_parts = normal_parts

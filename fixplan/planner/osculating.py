@@ -86,7 +86,8 @@ FORCE_DUAL_FLOOR = 1e-6
 #: of benchmarks/bench_exact.py (seeds 1-15 and 100-114 of its loads) rounds per re-solve
 #: 5.3 and 5.1 -> 4.3 and 4.1, from scratch 4.7 and 4.0 -> 4.1 and 3.5. Never in a first
 #: round: on its pinch, whose two contacts share the load by statics, the ray's point settled
-#: in 2 rounds, the normal's in 3.
+#: in 2 rounds, the normal's in 3. Any load whose excess fell by less than this factor also
+#: gets the tangent plane itself as its cut (see ``CUT_SLACK``).
 PROGRESS = 0.1
 
 #: Tangent-plane cuts per (contact, load case) besides the ellipsoid: each load outside its
@@ -110,10 +111,10 @@ CUT_SLOTS = 2
 #: Clarabel took 58.8 iterations and 4.03 rounds per re-solve against 71.3 and 4.39 with tangent
 #: cuts, and 487 against 580 with the safety analysis (20 re-solves); 60 random problems of
 #: tests/test_osculating_agreement.py's kinds took 904 rounds against 920, with the same two left
-#: to the cutting planes. A load that
-#: its ellipsoid does not bring in (placed at its ray, on the grasp of bench_realtime.py a load
-#: stayed 2e-7 outside round after round) needs the tangent plane: with every cut moved out, 3
-#: of that grasp's first 500 re-solves went to the cutting planes (none with tangent cuts).
+#: to the cutting planes. A load that its ellipsoid does not bring in (placed at its ray, on the
+#: grasp of bench_realtime.py a load stayed 2e-7 outside round after round) needs the tangent
+#: plane: with every cut moved out, 3 of that grasp's first 500 re-solves went to the cutting
+#: planes (none with tangent cuts).
 #: With every cut moved out by 5e-2 the iterations were about the same, but a problem whose
 #: optimum needs no force did not settle in 12 rounds.
 CUT_SLACK = 2e-2
