@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from fixplan.planner.cone_interior_point import ConeInteriorPoint
+from fixplan.planner.cone_interior_point import ConeInteriorPoint, pivot_rows
 
 TOLERANCES = {"tol_feas": 1e-9, "tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9}
 
@@ -144,7 +144,9 @@ def _assert_optimal(found, q, a, b, equalities, nonneg, dimensions):
     assert _cone_margin(slack, equalities, nonneg, dimensions) >= -1e-8 * size
     assert np.abs(q + a.T @ z).max() <= 1e-8 * (1.0 + np.abs(q).max() + np.abs(z).max())
     assert _cone_margin(z, equalities, nonneg, dimensions) >= 0.0
-    assert slack[equalities:] @ z[equalities:] <= 1e-8 * max(1.0, abs(q @ x))  # complementary
+    # Complementary: the method's gap is relative to its standard form's objective, which
+    # differs from q'x by a constant (up to 1.3e-8 of |q'x| on the programs with cut rows).
+    assert slack[equalities:] @ z[equalities:] <= 3e-8 * max(1.0, abs(q @ x))
 
 
 def test_an_infeasible_program_is_given_up():
@@ -178,16 +180,90 @@ def test_a_zero_where_the_pattern_has_an_entry_is_given_up():
     assert solver.solve(q, a, b) is None
 
 
-def test_cone_rows_of_at_most_one_entry_that_reach_every_variable_fit():
+def test_cone_rows_that_each_variable_can_stand_for_fit():
+    """A program fits where every variable has a cone row of its own (a matching): rows of one
+    entry each, or of several (an ellipsoid's factor ``R`` times a friction load, a cut's
+    plane); not where a variable is in no cone row or two share the only row they are in."""
     identity = np.vstack([np.ones((2, 3)), -np.eye(3)])
-    assert ConeInteriorPoint.fits(2, identity)
-    assert ConeInteriorPoint.fits(2, identity[[0, 1, 3, 4, 2]])  # (rows of the cones permuted)
-    assert ConeInteriorPoint.fits(2, np.vstack([identity, np.zeros(3), [0.0, 2.0, 0.0]]))
-    two_in_a_row = identity.copy()
-    two_in_a_row[2, 1] = 1.0
-    assert not ConeInteriorPoint.fits(2, two_in_a_row)
+    assert ConeInteriorPoint.fits(2, 0, identity)
+    assert ConeInteriorPoint.fits(2, 0, identity[[0, 1, 3, 4, 2]])  # (cone rows permuted)
+    assert ConeInteriorPoint.fits(2, 0, np.vstack([identity, np.zeros(3), [0.0, 2.0, 0.0]]))
+    triangular = np.vstack([np.ones((2, 3)), np.triu(np.ones((3, 3)))])
+    assert ConeInteriorPoint.fits(2, 0, triangular)
+    assert ConeInteriorPoint.fits(2, 1, np.vstack([triangular[:2], np.ones(3), triangular[2:]]))
     free_variable = np.vstack([np.ones((2, 4)), np.c_[-np.eye(3), np.zeros(3)]])
-    assert not ConeInteriorPoint.fits(2, free_variable)
+    assert not ConeInteriorPoint.fits(2, 0, free_variable)
+    shared = np.vstack([np.ones((2, 3)), [1.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 2.0]])
+    assert not ConeInteriorPoint.fits(2, 0, shared)
+
+
+def test_pivot_rows_prefer_second_order_cones_then_fewer_entries():
+    """A friction load ``l`` in an ellipsoid's cone (``‖R l‖ <= n``, ``R`` upper triangular)
+    and in a cut's row (``p·l <= h``, nonnegative, before the cone): its coordinates stand for
+    the cone's rows, whose block is triangular, not for the cut's row, which is empty until a
+    cut is placed; with one entry per row in cones of one kind, each variable's first row."""
+    cut = [[1.0, 1.0, 1.0, 0.0]]
+    cone = [[0.0, 0.0, 0.0, 1.0]] + np.c_[np.triu(np.ones((3, 3))), np.zeros(3)].tolist()
+    rows = pivot_rows(np.array(cut + cone) != 0.0, 1)
+    np.testing.assert_array_equal(rows, [2, 3, 4, 1])
+    one_entry = np.array([[0.0, 1.0], [1.0, 0.0], [0.0, 3.0], [2.0, 0.0]]) != 0.0
+    np.testing.assert_array_equal(pivot_rows(one_entry, 0), [1, 0])
+    np.testing.assert_array_equal(pivot_rows(one_entry, 2), [3, 2])
+
+
+def _mixed(q, a, rng, block=3):
+    """The program of ``(q, a)`` in the variables ``x = T y`` (``T`` block upper triangular,
+    blocks of ``block`` variables, well conditioned): ``(T'q, a T)``, whose cone rows hold
+    several entries each, as an osculating ellipsoid's do."""
+    n = len(q)
+    mixing = np.eye(n)
+    for first in range(0, n, block):
+        last = min(first + block, n)
+        mixing[first:last, first:last] += np.triu(rng.uniform(-0.5, 0.5, (last - first,) * 2), 1)
+    return mixing.T @ q, a @ mixing
+
+
+@pytest.mark.parametrize(
+    ("equalities", "nonneg", "dimensions", "apex_duals", "constants", "repeats"),
+    [
+        (6, 0, [4] * 8, 0, 0, 0),  # (the exact grasp's round, but for its cut rows: 8 x 4)
+        (6, 16, [4] * 8, 2, 0, 16),  # (with its 16 cut rows: nonnegative rows of loads)
+        (3, 4, [3, 5, 2], 1, 0, 0),
+        (4, 3, [3, 3, 4], 1, 3, 3),
+    ],
+)
+def test_cone_rows_of_several_entries_are_solved_to_clarabels_optimum(
+    equalities, nonneg, dimensions, apex_duals, constants, repeats
+):
+    """Cone rows that mix variables (``x`` for ``G_P^-1 (h_P - s_P)`` on the pivot rows):
+    the optimality conditions hold and the optimum is Clarabel's, from a cold start and from
+    the last optimum after the matrix changed a little (the osculating rounds' ellipsoids)."""
+    rng = np.random.default_rng(7 + len(dimensions) + nonneg + repeats)
+    for _ in range(10):
+        q, a, b = _program(
+            rng, equalities, nonneg, dimensions,
+            apex_duals=apex_duals, constants=constants, repeats=repeats,
+        )  # fmt: skip
+        mixed_q, mixed_a = _mixed(q, a, rng)
+        solver = ConeInteriorPoint(equalities, nonneg, dimensions, mixed_a, TOLERANCES)
+        assert not solver._diagonal
+        found = solver.solve(mixed_q, mixed_a, b)
+        _assert_optimal(found, mixed_q, mixed_a, b, equalities, nonneg, dimensions)
+        cold = solver.iterations
+        moved_a = mixed_a + 1e-3 * (_mixed(q, a, np.random.default_rng(0))[1] - mixed_a)
+        _assert_optimal(solver.solve(mixed_q, moved_a, b), mixed_q, moved_a, b, equalities,
+                        nonneg, dimensions)  # fmt: skip
+        assert solver.iterations <= cold
+
+
+def test_a_singular_block_of_pivot_rows_is_given_up():
+    """Where the values make the pivot rows' block singular (a cut's row that stands for a
+    variable, still empty), the method gives up rather than divide by 0."""
+    a = np.array([[1.0, 1.0], [-1.0, -1.0], [-1.0, 0.0], [0.0, -1.0]])
+    solver = ConeInteriorPoint(1, 1, [2], a)
+    empty = a.copy()
+    empty[[2, 3]] = [[-1.0, -1.0], [-1.0, -1.0]]
+    assert solver.solve(np.array([1.0, 2.0]), empty, np.array([1.0, 0.0, 0.0, 0.0])) is None
 
 
 def test_the_scaling_is_nesterov_todds():

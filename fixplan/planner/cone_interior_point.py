@@ -5,16 +5,22 @@ With ellipsoid or cone models, the planner's programs are, in Clarabel's form,
 .. math:: \min q^T x \quad\text{s.t.}\quad A_E x = b_E,\quad h - G x \in K
           = \mathbb{R}_+^{l} \times \mathcal{Q}^{d_1} \times \dots
 
-where every row of ``G`` holds at most one entry and every variable at least one: each
-variable is a scaled coordinate of a cone (a normal force, a friction force, a moment, a load
-multiple and its bounds), and a row without one is a constant coordinate (a given normal
-force). In the cone coordinates ``s = h - G x`` the program is in standard form,
-``min c^T s`` s.t. ``F s = f``, ``s`` in ``K``: the rows of ``A_E`` in ``s`` (each variable
-through its first row), plus ``s_r = h_r`` for a constant row and the link between the first
-row of a variable and each further one. Its primal-dual interior-point method needs one
-``p x p`` system per step, ``F W^2 F^T`` (``W`` the Nesterov-Todd scaling; ``p`` is six per load
-case and one per such extra row), where Clarabel factorises the whole KKT system: about 8 of
-its iterations of 20 µs each for one 8-contact case.
+where every variable is a coordinate of a cone, scaled, or a few variables mix into a few
+rows: ``G`` restricted to one *pivot* row per variable (``G_P``, :func:`pivot_rows`) is
+invertible. With ellipsoid or cone models each row holds at most one entry (a normal force, a
+friction force, a moment, a load multiple and its bounds; a row without one is a constant
+coordinate, a given normal force) and ``G_P`` is diagonal; the osculating ellipsoids of exact
+models (``‖R l‖ <= n``, ``R`` upper triangular) and their cuts (``p·l <= h``) mix the three
+components of a friction load, and ``G_P`` is triangular in blocks of three. In the cone
+coordinates ``s = h - G x``, ``x = G_P^{-1} (h_P - s_P)``, and the program is in standard form,
+``min c^T s`` s.t. ``F s = f``, ``s`` in ``K``: the rows of ``A_E`` in ``s``, plus the link of
+each further row ``t`` to the pivot rows, ``s_t - G_t G_P^{-1} s_P = h_t - G_t G_P^{-1} h_P``
+(``s_t = h_t`` for a constant row). Its primal-dual interior-point method needs one ``p x p``
+system per step, ``F W^2 F^T`` (``W`` the Nesterov-Todd scaling; ``p`` is six per load case and
+one per further row), where Clarabel factorises the whole KKT system: about 8 of its
+iterations of 20 µs each for one 8-contact case. (A round of the exact grasp of
+``benchmarks/bench_realtime.py``, with two cut rows per contact, has ``p = 22``: 4 iterations
+of about 40 µs from the last round's optimum.)
 
 The method is the infeasible-start path-following method with Mehrotra's predictor and
 corrector (as in CVXOPT's ``coneqp`` and SDPT3), compiled in one call. Small pivots of the
@@ -63,14 +69,17 @@ WARM_SHIFT, SHIFT_MAX = 1e-3, 1e-1
 RAY_RTOL = 1e-6
 #: A Cholesky pivot below this fraction of its diagonal entry is replaced by ``HUGE_PIVOT``.
 PIVOT_RTOL, HUGE_PIVOT = 1e-30, 1e128
+#: The block of ``G`` on the pivot rows counts as singular (the method gives up) where a pivot
+#: of its elimination is below this fraction of its largest entry.
+BLOCK_PIVOT_RTOL = 1e-12
 
 
 class ConeInteriorPoint:
     """Solves ``min q'x`` s.t. ``A x + s = b``, ``s`` in ``equalities`` zero rows,
     ``nonnegative`` rows and second-order cones of ``dimensions``, for ``A`` (dense, nonzero
-    only where ``pattern`` is) whose cone rows hold at most one entry each and every variable
-    at least one (:meth:`fits`). ``settings`` may set :data:`TOLERANCES` (other Clarabel
-    settings are ignored)."""
+    only where ``pattern`` is) whose cone rows have a pivot row for every variable
+    (:meth:`fits`). ``settings`` may set :data:`TOLERANCES` (other Clarabel settings are
+    ignored)."""
 
     def __init__(
         self,
@@ -85,11 +94,13 @@ class ConeInteriorPoint:
         self._zero = int(equalities)
         self._nonneg = int(nonnegative)
         self._dimensions = np.asarray(dimensions, dtype=np.int64).reshape(-1)
+        #: The cone row whose coordinate stands for each variable (:func:`pivot_rows`), and
+        #: whether those rows hold one entry each (their block of ``G`` is diagonal).
         cone = np.asarray(pattern)[self._zero :] != 0.0
-        #: The variable of each cone row (-1: a constant row), and the first row of each
-        #: variable (whose coordinate stands for it).
-        self._variable = np.where(cone.any(axis=1), cone.argmax(axis=1), -1).astype(np.int64)
-        self._first_row = cone.argmax(axis=0).astype(np.int64)
+        self._pivot_row = pivot_rows(cone, self._nonneg)
+        if self._pivot_row is None:
+            raise ValueError("the pattern does not fit the method (see ConeInteriorPoint.fits)")
+        self._diagonal = bool(np.all(cone[self._pivot_row].sum(axis=1) == 1))
         #: The standard form's last optimum ``(s, y, z)`` by cost ``q``: the next solve of that
         #: cost starts there.
         self._optima: dict[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
@@ -97,11 +108,11 @@ class ConeInteriorPoint:
         self.iterations = 0
 
     @staticmethod
-    def fits(equalities: int, pattern: np.ndarray) -> bool:
-        """Whether the cone rows of ``pattern`` (``A`` or its nonzero pattern) hold at most
-        one entry each and every variable at least one."""
+    def fits(equalities: int, nonnegative: int, pattern: np.ndarray) -> bool:
+        """Whether each variable of ``pattern`` (``A`` or its nonzero pattern) can stand for a
+        cone row of its own (:func:`pivot_rows`)."""
         cone = np.asarray(pattern)[equalities:] != 0.0
-        return bool(np.all(cone.sum(axis=1) <= 1)) and bool(np.all(cone.any(axis=0)))
+        return pivot_rows(cone, nonnegative) is not None
 
     def solve(
         self, q: np.ndarray, a: np.ndarray, b: np.ndarray
@@ -116,8 +127,8 @@ class ConeInteriorPoint:
             m = rows - self._zero
             start = kept if warm else (np.empty(m), np.empty(self._zero + m - n), np.empty(m))
             status, self.iterations = _SOLVE(
-                q, a, b, self._zero, self._nonneg, self._dimensions, self._variable,
-                self._first_row, x, z, *start, warm, *self._tolerances, MAX_ITERATIONS,
+                q, a, b, self._zero, self._nonneg, self._dimensions, self._pivot_row,
+                self._diagonal, x, z, *start, warm, *self._tolerances, MAX_ITERATIONS,
                 STEP_FRACTION, WARM_SHIFT, SHIFT_MAX, RAY_RTOL,
             )  # fmt: skip
             if status == 0:
@@ -130,15 +141,44 @@ class ConeInteriorPoint:
         return None
 
 
+def pivot_rows(cone: np.ndarray, nonnegative: int) -> np.ndarray | None:
+    """The cone row whose coordinate stands for each variable of the pattern ``cone`` (rows
+    ``(m, n)`` of ``G``, the first ``nonnegative`` of them nonnegative rows): distinct rows,
+    found as a matching of variables to rows, rows of second-order cones before nonnegative
+    ones (a cut's row may be empty now), then rows of fewer entries before others and earlier
+    rows before later ones (where every row holds one entry, its block of ``G`` is diagonal). ``None`` where no such rows exist (a variable in no cone
+    row, or fewer rows than variables among some variables' rows)."""
+    m, n = cone.shape
+    entries = [np.flatnonzero(row) for row in cone]
+    order = sorted(range(m), key=lambda r: (len(entries[r]), r < nonnegative, r))
+    row_of = np.full(n, -1, dtype=np.int64)
+
+    def augment(r: int, seen: set) -> bool:
+        for j in entries[r]:
+            if j in seen:
+                continue
+            seen.add(j)
+            if row_of[j] < 0 or augment(row_of[j], seen):
+                row_of[j] = r
+                return True
+        return False
+
+    for r in order:
+        if len(entries[r]):
+            augment(r, set())
+    return None if np.any(row_of < 0) else row_of
+
+
 def solve_standard_form(
-    q, a, b, zero, nonneg, dimensions, variable, first_row, x_out, z_out, s, y, z, warm,
+    q, a, b, zero, nonneg, dimensions, pivot_row, diagonal, x_out, z_out, s, y, z, warm,
     tol_feas, tol_gap_abs, tol_gap_rel, max_iterations, step_fraction, warm_shift, shift_max,
     ray_rtol,
 ):  # fmt: skip  # pragma: no cover - compiled
     """Write the optimum of Clarabel's program into ``x_out`` and ``z_out``, and that of its
     standard form into ``s``, ``y`` and ``z`` (with ``warm``, the start); ``(0, iterations)``
     when solved, ``(2, iterations)`` where the iterates ran off along a ray (see
-    :func:`standard_form`), else ``(1, iterations)``."""
+    :func:`standard_form`), else ``(1, iterations)`` (also where the pivot rows' block of ``G``
+    is singular now)."""
     n = a.shape[1]
     m = a.shape[0] - zero
     blocks = nonneg + dimensions.shape[0]
@@ -149,39 +189,43 @@ def solve_standard_form(
         start[k] = row
         size[k] = 1 if k < nonneg else dimensions[k - nonneg]
         row += size[k]
-    # In s = h - G x, variable j is x_j = (h_r - s_r) / g_r of its first row r. So the rows of
-    # A_E x = b_E are F s = f with F[:, r] = -A_E[:, j] / g_r, f = b_E - sum_j A_E[:, j] h_r / g_r;
-    # q'x = c's + constant with c_r = -q_j / g_r; a further row t of variable j is
-    # s_t - (g_t / g_r) s_r = h_t - g_t h_r / g_r, and a constant row t is s_t = h_t.
-    gain = np.empty(m)
-    for t in range(m):
-        gain[t] = a[zero + t, variable[t]] if variable[t] >= 0 else 1.0
-        if gain[t] == 0.0:  # (an entry of the pattern that is 0 now)
-            return 1, 0
+    # In s = h - G x, with P the pivot rows (one per variable) and M = G_P^-1, x = M (h_P - s_P).
+    # So A_E x = b_E is F s = f with F[:, P] = -A_E M, f = b_E - A_E M h_P; q'x = c's + constant
+    # with c_P = -M'q; a further cone row t is s_t - (G_t M) s_P = h_t - G_t M h_P.
+    rows_of, columns_of, values_of = _block_inverse(a[zero:], pivot_row, diagonal)
+    if rows_of.shape[0] == 0:
+        return 1, 0
+    h_p = np.empty(n)
+    for j in range(n):
+        h_p[j] = b[zero + pivot_row[j]]
     p = zero + m - n
     f_matrix = np.zeros((p, m))
     f = np.zeros(p)
     c = np.zeros(m)
     for e in range(zero):
         f[e] = b[e]
-    for j in range(n):
-        r = first_row[j]
-        h = b[zero + r]
-        c[r] = -q[j] / gain[r]
+    for t in range(rows_of.shape[0]):
+        j, k, value = rows_of[t], columns_of[t], values_of[t]
+        r = pivot_row[k]
+        c[r] -= q[j] * value
         for e in range(zero):
-            f_matrix[e, r] = -a[e, j] / gain[r]
-            f[e] -= a[e, j] * h / gain[r]
+            f_matrix[e, r] -= a[e, j] * value
+            f[e] -= a[e, j] * value * h_p[k]
+    pivot = np.zeros(m, dtype=np.bool_)
+    for j in range(n):
+        pivot[pivot_row[j]] = True
     link = zero
     for t in range(m):
-        j = variable[t]
-        if j >= 0 and first_row[j] == t:
+        if pivot[t]:
             continue
         f_matrix[link, t] = 1.0
         f[link] = b[zero + t]
-        if j >= 0:
-            r = first_row[j]
-            f_matrix[link, r] = -gain[t] / gain[r]
-            f[link] -= gain[t] * b[zero + r] / gain[r]
+        for u in range(rows_of.shape[0]):
+            j, k, value = rows_of[u], columns_of[u], values_of[u]
+            entry = a[zero + t, j] * value
+            if entry != 0.0:
+                f_matrix[link, pivot_row[k]] -= entry
+                f[link] -= entry * h_p[k]
         link += 1
     status, iterations = _STANDARD(f_matrix, f, c, start, size, nonneg, s, y, z, warm, tol_feas,
                                    tol_gap_abs, tol_gap_rel, max_iterations, step_fraction,
@@ -189,14 +233,78 @@ def solve_standard_form(
     if status != 0:
         return status, iterations
     # Back: x from s; Clarabel's multipliers are -y on the equalities and z on the cones.
-    for j in range(n):
-        r = first_row[j]
-        x_out[j] = (b[zero + r] - s[r]) / gain[r]
+    x_out[:] = 0.0
+    for t in range(rows_of.shape[0]):
+        j, k = rows_of[t], columns_of[t]
+        x_out[j] += values_of[t] * (h_p[k] - s[pivot_row[k]])
     for t in range(m):
         z_out[zero + t] = z[t]
     for e in range(zero):
         z_out[e] = -y[e]
     return 0, iterations
+
+
+def _block_inverse(g, pivot_row, diagonal):  # pragma: no cover - compiled
+    """The nonzero entries ``(rows, columns, values)`` of ``G_P^-1``, ``G_P`` the rows
+    ``pivot_row`` of ``g`` (its row ``j`` is row ``pivot_row[j]``, ``diagonal`` where each holds
+    only entry ``j``); none where ``G_P`` is singular: an entry 0 on a diagonal one, else a
+    pivot of its Gauss-Jordan elimination (partial pivoting, zero multipliers skipped) below
+    ``BLOCK_PIVOT_RTOL`` of its largest entry."""
+    n = pivot_row.shape[0]
+    if diagonal:
+        rows = np.arange(n)
+        values = np.empty(n)
+        for j in range(n):
+            entry = g[pivot_row[j], j]
+            if entry == 0.0:
+                return rows[:0], rows[:0], values[:0]
+            values[j] = 1.0 / entry
+        return rows, rows, values
+    work = np.empty((n, n))
+    out = np.zeros((n, n))
+    largest = 0.0
+    for j in range(n):
+        out[j, j] = 1.0
+        for k in range(n):
+            work[j, k] = g[pivot_row[j], k]
+            largest = max(largest, abs(work[j, k]))
+    for k in range(n):
+        best, chosen = 0.0, -1
+        for i in range(k, n):
+            if abs(work[i, k]) > best:
+                best, chosen = abs(work[i, k]), i
+        if chosen < 0 or best <= BLOCK_PIVOT_RTOL * largest:
+            empty = np.zeros(0, dtype=np.int64)
+            return empty, empty, np.zeros(0)
+        if chosen != k:
+            for col in range(n):
+                work[k, col], work[chosen, col] = work[chosen, col], work[k, col]
+                out[k, col], out[chosen, col] = out[chosen, col], out[k, col]
+        scale = 1.0 / work[k, k]
+        for col in range(n):
+            work[k, col] *= scale
+            out[k, col] *= scale
+        for i in range(n):
+            factor = work[i, k]
+            if i == k or factor == 0.0:
+                continue
+            for col in range(n):
+                work[i, col] -= factor * work[k, col]
+                out[i, col] -= factor * out[k, col]
+    count = 0
+    for i in range(n):
+        for k in range(n):
+            count += out[i, k] != 0.0
+    rows = np.empty(count, dtype=np.int64)
+    columns = np.empty(count, dtype=np.int64)
+    values = np.empty(count)
+    count = 0
+    for i in range(n):
+        for k in range(n):
+            if out[i, k] != 0.0:
+                rows[count], columns[count], values[count] = i, k, out[i, k]
+                count += 1
+    return rows, columns, values
 
 
 def standard_form(
@@ -590,5 +698,6 @@ _modified_cholesky = compiled_scalar(_modified_cholesky)
 _cholesky_solve = compiled_scalar(_cholesky_solve)
 _mehrotra_start = compiled_scalar(_mehrotra_start)
 _direction = compiled_scalar(_direction)
+_block_inverse = compiled_scalar(_block_inverse)
 _STANDARD = compiled_scalar(standard_form)
 _SOLVE = compiled_scalar(solve_standard_form)

@@ -9,7 +9,7 @@ and the linear cost ``q``. This module applies those maps itself, keeps one Clar
 ``A``, ``b`` and ``q`` are updated in place, and reads the variables and the multipliers of
 equality constraints from the solution vectors. Linear programs (pyramid models) are solved by a
 warm-started dual simplex (:mod:`fixplan.planner.dual_simplex`) instead, and small cone programs
-in standard form (ellipsoid and cone models) by a compiled interior-point method
+(ellipsoid and cone models, the osculating rounds of exact ones) by a compiled interior-point method
 (:mod:`fixplan.planner.cone_interior_point`), with Clarabel where either gives up. It checks
 itself against cvxpy's answer when it is built and refuses (returns ``None``) where its
 assumptions do not hold (a parametric ``P``, cones Clarabel's direct path does not cover, cvxpy
@@ -140,7 +140,7 @@ class DirectSolver:
             and len(b) * len(q) <= INTERIOR_MAX_ENTRIES
         ):
             pattern = program.dense(np.ones_like(a))
-            if ConeInteriorPoint.fits(dims.zero, pattern):
+            if ConeInteriorPoint.fits(dims.zero, dims.nonneg, pattern):
                 interior = ConeInteriorPoint(dims.zero, dims.nonneg, dims.soc, pattern, settings)
         pattern = Pattern.of(*program.pattern, dims.zero, dims.nonneg, dims.soc)
         direct = cls(problem, solver, program, offsets, rows, pattern, simplex, interior)

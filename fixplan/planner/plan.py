@@ -75,8 +75,9 @@ class Plan:
         The solver that produced the answer, with its method in parentheses where it matters:
         ``"dual simplex (direct)"``, ``"interior point (direct)"``, ``"CLARABEL (direct)"``,
         and for exact friction models ``"CLARABEL (osculating ellipsoids)"`` or
-        ``"CLARABEL (cutting planes)"``; blocks solved differently are listed, separated by
-        commas.
+        ``"CLARABEL (cutting planes)"`` (once a planner has solved a program twice, its rounds
+        are solved directly: by the compiled interior point where the program is small, else
+        by Clarabel); blocks solved differently are listed, separated by commas.
     solve_time : float
         Wall time of the solve(s) [s].
     """
