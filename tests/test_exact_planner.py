@@ -543,3 +543,33 @@ def test_a_grasp_that_needs_no_clamp_force_settles_in_the_rounds(step, monkeypat
         assert plan.solver == "CLARABEL (osculating ellipsoids)"
         assert abs(plan.objective_value) <= 1e-7 and abs(reference.objective_value) <= 1e-7  # [N]
         assert plan.safety_factor == pytest.approx(reference.safety_factor, rel=1e-7)
+
+
+def test_the_rounds_of_a_small_grasp_go_to_the_compiled_interior_point(monkeypatch):
+    """The osculating programs of the 8-contact grasp of benchmarks/bench_realtime.py (one
+    case: rows of ``R l`` and of cuts mix a load's components) are solved by the compiled
+    interior point once the planner re-solves; along its path the plans are those of rounds
+    solved by Clarabel (a planner whose programs the interior point is told not to fit), to
+    1e-7, with every load inside its exact surface."""
+    from fixplan.planner.cone_interior_point import ConeInteriorPoint
+
+    angles = np.linspace(0.0, 4.0 * np.pi, 10_000)[:40]
+    path = [
+        [Load(name="cut", force=[80.0 * np.cos(a), 80.0 * np.sin(a), -30.0],
+              point=[0.02 * np.cos(a / 2), 0.01, 0.04], torque=[0.0, 0.0, 0.8 * np.sin(a)])]
+        for a in angles
+    ]  # fmt: skip
+    problem = bench_fixture(path[0], "exact")
+    interior = Planner(problem)
+    found = [interior.solve(loads) for loads in path]
+    rounds = interior._runner._direct[(problem.objective, True)]
+    assert rounds.method == "interior point"
+    monkeypatch.setattr(ConeInteriorPoint, "fits", staticmethod(lambda *pattern: False))
+    clarabel = Planner(problem)
+    expected = [clarabel.solve(loads) for loads in path]
+    assert clarabel._runner._direct[(problem.objective, True)].method == "CLARABEL"
+    for plan, reference in zip(found, expected, strict=True):
+        assert plan.solver == reference.solver == "CLARABEL (osculating ellipsoids)"
+        assert plan.objective_value == pytest.approx(reference.objective_value, rel=OPTIMUM_RTOL)
+        assert plan.safety_factor == pytest.approx(reference.safety_factor, rel=OPTIMUM_RTOL)
+        assert_loads_inside_their_exact_surfaces(problem, plan)
