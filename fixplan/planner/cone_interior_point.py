@@ -144,10 +144,11 @@ class ConeInteriorPoint:
 def pivot_rows(cone: np.ndarray, nonnegative: int) -> np.ndarray | None:
     """The cone row whose coordinate stands for each variable of the pattern ``cone`` (rows
     ``(m, n)`` of ``G``, the first ``nonnegative`` of them nonnegative rows): distinct rows,
-    found as a matching of variables to rows, rows of second-order cones before nonnegative
-    ones (a cut's row may be empty now), then rows of fewer entries before others and earlier
-    rows before later ones (where every row holds one entry, its block of ``G`` is diagonal). ``None`` where no such rows exist (a variable in no cone
-    row, or fewer rows than variables among some variables' rows)."""
+    found as a matching of variables to rows that takes rows of fewer entries first, then rows
+    of second-order cones before nonnegative ones (a cut's row, as full as the ellipsoid's
+    first, may be empty now), then earlier rows (where every row holds one entry, the block of
+    ``G`` is diagonal). ``None`` where no such rows exist (a variable in no cone row, or fewer
+    rows than variables among some variables' rows)."""
     m, n = cone.shape
     entries = [np.flatnonzero(row) for row in cone]
     order = sorted(range(m), key=lambda r: (len(entries[r]), r < nonnegative, r))
