@@ -205,8 +205,8 @@ def _newton(kernel, eps2, twist, b1, b2, kinks, current, given=False):  # pragma
     region ended the iteration (a relative change of the size of that step, about 1e-6).
     With :data:`PROBES` Newton also stops where its decrement stalls next to a kink
     (:data:`STALLED_DECREMENT`) and names that kink's support point. With ``given``,
-    ``current`` holds the terms at ``twist`` already (estimated: only the first step uses
-    them; every later iterate's terms are evaluated)."""
+    ``current`` holds the terms at ``twist`` already (estimated: they set the first step, never
+    the answer; every later iterate's terms are evaluated)."""
     local = np.empty(10)
     new = np.empty(10)
     step = np.empty(3)
@@ -214,10 +214,10 @@ def _newton(kernel, eps2, twist, b1, b2, kinks, current, given=False):  # pragma
     if not given:
         _terms(kernel, eps2, twist, True, local, current)
     previous = np.inf
-    for _ in range(INVERSE_MAX_ITERATIONS):
+    for iteration in range(INVERSE_MAX_ITERATIONS):
         h = current[0]
         s1, s2, decrement = _newton_step(*_projected(current, b1, b2))
-        if decrement <= INVERSE_RTOL**2 * h:
+        if decrement <= INVERSE_RTOL**2 * h and not (given and iteration == 0):
             return False, h, -1
         if kinks == PROBES and decrement > STALLED_DECREMENT * previous:
             slowest, speed = _slowest_point(kernel, twist)
