@@ -226,3 +226,34 @@ def test_a_fixture_with_facing_locators_agrees(seed, monkeypatch):
     # 0.111, 0.269 with the ellipsoids against 0, 0, 0 with the cutting planes).
     assert_same_plans(problem, plan, reference, planar_motion=False, lower_ends=False)
     assert math.isfinite(plan.objective_value)
+
+
+def test_a_warm_re_solve_leaves_no_limiting_load_inside_its_set(monkeypatch):
+    """A pinch (a combined pair of disks against a tactile grid, clamps) re-solved with new
+    loads settled, with ``COMPLEMENTARITY_RTOL`` at 1e-5, with a limiting load 1.7e-5 inside
+    its set and clamp forces 3.9e-6 above the optimum (cutting planes, and a fresh planner, got
+    it to 2e-9): every plan of the warm planner is the cutting planes' to 1e-7 (3.7e-9 at
+    most, seen)."""
+    names = [*PATCHES, "combined"]
+
+    def problem_of(seed):
+        rng = np.random.default_rng(seed)
+        patches = [names[i] for i in rng.choice(len(names), 2)]
+        return pinch(rng, patches, "min-total-clamp-force")
+
+    problem = problem_of(15)
+    new_loads = [problem_of(10_000 + 7 * 15 + j).loads for j in range(3)]
+    warm = Planner(problem)
+    plans = [warm.solve(), warm.solve(), *(warm.solve(loads) for loads in new_loads)]
+    with monkeypatch.context() as patch:
+        patch.setattr(runner, "smooth", lambda models: False)
+        cutting = Planner(problem)
+        references = [
+            cutting.solve(),
+            cutting.solve(),
+            *(cutting.solve(loads) for loads in new_loads),
+        ]
+    for plan, reference in zip(plans, references, strict=True):
+        assert plan.solver == "CLARABEL (osculating ellipsoids)"
+        assert plan.objective_value == pytest.approx(reference.objective_value, rel=OPTIMUM_RTOL)
+        assert_loads_inside_their_exact_surfaces(problem, plan)
