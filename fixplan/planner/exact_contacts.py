@@ -94,10 +94,13 @@ class ExactContacts:
     def _by_model(self, owner: np.ndarray):
         """``(model, rows)`` per distinct model of the exact contacts ``owner`` ``(P,)``: the rows
         of ``owner`` whose contact has that model, in order (their loads are queried in one
-        call)."""
+        call). (A test per distinct model: ``np.unique`` cost 10 µs a call on the few models of a
+        grasp.)"""
         which = self._model_of[owner]
-        for index in np.unique(which):
-            yield self._distinct[index], np.flatnonzero(which == index)
+        for index, model in enumerate(self._distinct):
+            rows = np.flatnonzero(which == index)
+            if rows.size:
+                yield model, rows
 
     def _normal_values(self) -> np.ndarray:
         """``(C, K)`` normal forces [N] of the last solve."""
