@@ -476,6 +476,15 @@ def test_cuts_moved_off_the_tangent_plane_save_interior_point_iterations(monkeyp
     assert moved_iterations < 0.9 * tangent_iterations, (moved_iterations, tangent_iterations)
 
 
+def realtime_loads(step: int) -> list[Load]:
+    """The load case at ``step`` of the path of benchmarks/bench_realtime.py (10,000 steps): a
+    cutting force of 80 N turning in the plane, a torque varying with it."""
+    angle = np.linspace(0.0, 4.0 * np.pi, 10_000)[step]
+    return [Load(name="cut", force=[80.0 * np.cos(angle), 80.0 * np.sin(angle), -30.0],
+                 point=[0.02 * np.cos(angle / 2), 0.01, 0.04],
+                 torque=[0.0, 0.0, 0.8 * np.sin(angle)])]  # fmt: skip
+
+
 def test_a_load_stuck_outside_its_exact_set_gets_the_tangent_plane_itself():
     """A load whose excess a round did not reduce (``PROGRESS``) gets the exact set's tangent
     plane as its cut, not the plane moved out by ``CUT_SLACK``: along the path of
@@ -483,12 +492,7 @@ def test_a_load_stuck_outside_its_exact_set_gets_the_tangent_plane_itself():
     slowly), steps 337 and 338 left a load 2e-7 outside round after round with the moved plane
     (its ellipsoid, placed at the load's ray, did not bring it in) and went to the cutting
     planes. Every step up to there must settle in the rounds."""
-    angles = np.linspace(0.0, 4.0 * np.pi, 10_000)[:340]
-    path = [
-        [Load(name="cut", force=[80.0 * np.cos(a), 80.0 * np.sin(a), -30.0],
-              point=[0.02 * np.cos(a / 2), 0.01, 0.04], torque=[0.0, 0.0, 0.8 * np.sin(a)])]
-        for a in angles
-    ]  # fmt: skip
+    path = [realtime_loads(step) for step in range(340)]
     problem = bench_fixture(path[0], "exact")
     planner = Planner(problem)
     for loads in path[:3]:  # (as the benchmark warms up)
@@ -533,10 +537,7 @@ def test_a_grasp_that_needs_no_clamp_force_settles_in_the_rounds(step, monkeypat
     complementarity test round after round, and these steps (fresh planners; 22 of every
     twentieth step of the path from one planner) went to the cutting planes. The plan, its
     safety analysis included, is the cutting planes' (safety factors to 1e-7)."""
-    angle = np.linspace(0.0, 4.0 * np.pi, 10_000)[step]
-    loads = [Load(name="cut", force=[80.0 * np.cos(angle), 80.0 * np.sin(angle), -30.0],
-                  point=[0.02 * np.cos(angle / 2), 0.01, 0.04],
-                  torque=[0.0, 0.0, 0.8 * np.sin(angle)])]  # fmt: skip
+    loads = realtime_loads(step)
     problem = bench_fixture(loads, "exact")
     found, expected = solved_both_ways(problem, loads, monkeypatch)
     for plan, reference in zip(found, expected, strict=True):
@@ -553,12 +554,7 @@ def test_the_rounds_of_a_small_grasp_go_to_the_compiled_interior_point(monkeypat
     1e-7, with every load inside its exact surface."""
     from fixplan.planner.cone_interior_point import ConeInteriorPoint
 
-    angles = np.linspace(0.0, 4.0 * np.pi, 10_000)[:40]
-    path = [
-        [Load(name="cut", force=[80.0 * np.cos(a), 80.0 * np.sin(a), -30.0],
-              point=[0.02 * np.cos(a / 2), 0.01, 0.04], torque=[0.0, 0.0, 0.8 * np.sin(a)])]
-        for a in angles
-    ]  # fmt: skip
+    path = [realtime_loads(step) for step in range(40)]
     problem = bench_fixture(path[0], "exact")
     interior = Planner(problem)
     found = [interior.solve(loads) for loads in path]

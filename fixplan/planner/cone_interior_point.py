@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from fixplan.planner.dual_simplex import INVERT
 from fixplan.surface.point_kernel import compiled_scalar
 
 #: Stopping tolerances by Clarabel's names, and its defaults: primal and dual residuals
@@ -69,9 +70,6 @@ WARM_SHIFT, SHIFT_MAX = 1e-3, 1e-1
 RAY_RTOL = 1e-6
 #: A Cholesky pivot below this fraction of its diagonal entry is replaced by ``HUGE_PIVOT``.
 PIVOT_RTOL, HUGE_PIVOT = 1e-30, 1e128
-#: The block of ``G`` on the pivot rows counts as singular (the method gives up) where a pivot
-#: of its elimination is below this fraction of its largest entry.
-BLOCK_PIVOT_RTOL = 1e-12
 
 
 class ConeInteriorPoint:
@@ -248,9 +246,9 @@ def solve_standard_form(
 def _block_inverse(g, pivot_row, diagonal):  # pragma: no cover - compiled
     """The nonzero entries ``(rows, columns, values)`` of ``G_P^-1``, ``G_P`` the rows
     ``pivot_row`` of ``g`` (its row ``j`` is row ``pivot_row[j]``, ``diagonal`` where each holds
-    only entry ``j``); none where ``G_P`` is singular: an entry 0 on a diagonal one, else a
-    pivot of its Gauss-Jordan elimination (partial pivoting, zero multipliers skipped) below
-    ``BLOCK_PIVOT_RTOL`` of its largest entry."""
+    only entry ``j``); none where ``G_P`` is singular: an entry 0 on a diagonal one, else as
+    the dual simplex's Gauss-Jordan elimination finds it
+    (:func:`~fixplan.planner.dual_simplex.invert`)."""
     n = pivot_row.shape[0]
     if diagonal:
         rows = np.arange(n)
@@ -261,37 +259,10 @@ def _block_inverse(g, pivot_row, diagonal):  # pragma: no cover - compiled
                 return rows[:0], rows[:0], values[:0]
             values[j] = 1.0 / entry
         return rows, rows, values
-    work = np.empty((n, n))
-    out = np.zeros((n, n))
-    largest = 0.0
-    for j in range(n):
-        out[j, j] = 1.0
-        for k in range(n):
-            work[j, k] = g[pivot_row[j], k]
-            largest = max(largest, abs(work[j, k]))
-    for k in range(n):
-        best, chosen = 0.0, -1
-        for i in range(k, n):
-            if abs(work[i, k]) > best:
-                best, chosen = abs(work[i, k]), i
-        if chosen < 0 or best <= BLOCK_PIVOT_RTOL * largest:
-            empty = np.zeros(0, dtype=np.int64)
-            return empty, empty, np.zeros(0)
-        if chosen != k:
-            for col in range(n):
-                work[k, col], work[chosen, col] = work[chosen, col], work[k, col]
-                out[k, col], out[chosen, col] = out[chosen, col], out[k, col]
-        scale = 1.0 / work[k, k]
-        for col in range(n):
-            work[k, col] *= scale
-            out[k, col] *= scale
-        for i in range(n):
-            factor = work[i, k]
-            if i == k or factor == 0.0:
-                continue
-            for col in range(n):
-                work[i, col] -= factor * work[k, col]
-                out[i, col] -= factor * out[k, col]
+    out = np.empty((n, n))
+    if not INVERT(g, pivot_row, out):
+        empty = np.zeros(0, dtype=np.int64)
+        return empty, empty, np.zeros(0)
     count = 0
     for i in range(n):
         for k in range(n):

@@ -139,7 +139,7 @@ class DualSimplex:
             return updates
         if changed == 1:
             return updates + 1
-        return 0 if _INVERT(a, rows, inverse) else None
+        return 0 if INVERT(a, rows, inverse) else None
 
     def _cold(self, a, q, b):
         """From the artificial basis (see :meth:`_artificial`) of the costs perturbed by
@@ -270,7 +270,7 @@ def dual_pivots(a, b, q, equalities, rows, inverse, x, z, limit, feasibility, op
                     return -1
         if entering < 0:
             if since >= confirm:  # confirm on a fresh inverse
-                if not _INVERT(a, rows, inverse):
+                if not INVERT(a, rows, inverse):
                     return -1
                 since = 0
                 continue
@@ -315,7 +315,7 @@ def dual_pivots(a, b, q, equalities, rows, inverse, x, z, limit, feasibility, op
         pivots += 1
         since += 1
         if since >= refactor:
-            if not _INVERT(a, rows, inverse):
+            if not INVERT(a, rows, inverse):
                 return -1
             since = 0
 
@@ -392,6 +392,7 @@ def column_update(a, inverted, rows, inverse, smallest, allowed):  # pragma: no 
     return 1
 
 
-_INVERT = compiled_scalar(invert)
+#: :func:`invert`, compiled (also the elimination of :mod:`fixplan.planner.cone_interior_point`).
+INVERT = compiled_scalar(invert)
 _UPDATE = compiled_scalar(column_update)
 _PIVOTS = compiled_scalar(dual_pivots)

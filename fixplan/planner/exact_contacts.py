@@ -94,8 +94,8 @@ class ExactContacts:
     def _by_model(self, owner: np.ndarray):
         """``(model, rows)`` per distinct model of the exact contacts ``owner`` ``(P,)``: the rows
         of ``owner`` whose contact has that model, in order (their loads are queried in one
-        call). (A test per distinct model: ``np.unique`` cost 10 µs a call on the few models of a
-        grasp.)"""
+        call). (A test per distinct model: with ``np.unique`` a call took 13.5 µs against 5.9 µs
+        on the two models of the grasp of benchmarks/bench_realtime.py.)"""
         which = self._model_of[owner]
         for index, model in enumerate(self._distinct):
             rows = np.flatnonzero(which == index)

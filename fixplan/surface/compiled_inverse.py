@@ -92,7 +92,7 @@ STALLED_NEAR_KINK = 1e-7
 #: (relative) with the terms estimated there (:func:`_terms_near_facet`) rather than evaluated:
 #: next to the facets of 4,096 points (benchmarks/bench_limit_surface.py, starts about 1e-7
 #: away) 5.2 passes over the points with Hessians per query instead of 6.2, the same answers
-#: to 1.3e-15; the estimate's gradient is off by about ``1e3 d²`` at a distance ``d``.
+#: to 1.3e-15; the estimate's gradient is off by up to about ``4e3 d²`` at a distance ``d``.
 NEAR_FACET = 1e-4
 
 #: A Newton step damped below this fraction signals a kink: Newton stops there.
