@@ -111,10 +111,10 @@ def test_the_compiled_pass_gives_the_answers_of_its_parts(model, monkeypatch):
             direct,
             without,
         )
-        assert direct.dense_maps() is not None
+        assert direct.compiled_maps() is not None
         fused = carried.carry_at(*arguments)
         with monkeypatch.context() as patch:
-            patch.setattr(type(direct), "dense_maps", lambda self: None)
+            patch.setattr(type(direct), "compiled_maps", lambda self: None)
             alpha, worst, held, x, z, program = carried.carry_at(*arguments)
         held = without.held(*program[1:])
         assert fused[2] == held

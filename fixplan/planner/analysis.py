@@ -67,7 +67,7 @@ def analyse_cases(
         twists, moving = staying(dual, normal, wrenches)
         for j in range(cases):
             if high[j] < np.inf and moving[j]:
-                motions[names[j]] = Screw.from_twist(twists[:, j], length_scale)
+                motions[names[j]] = Screw(twists[:, j], length_scale)  # (twists: a new array)
     return {
         "safety_factors": dict(zip(names, high, strict=True)),
         "safety_factor": min(high),
@@ -109,8 +109,9 @@ class StayingInContact:
         #: contacts (its words of bits) among them.
         self._projections = np.eye(6)[None]  # (none pressed: the identity)
         self._index: dict[bytes, int] = {}
-        #: The words of the last call's pressed contacts and their groups.
-        self._last: tuple[bytes, np.ndarray] = (b"", np.zeros(0, dtype=np.intp))
+        #: The words of the last call's pressed contacts and their groups (a control loop's
+        #: cases keep their pressed contacts).
+        self._last = (np.zeros((0, self._words), dtype=np.uint64), np.zeros(0, dtype=np.intp))
 
     def __call__(
         self, twists: np.ndarray, normal_forces: np.ndarray, towards: np.ndarray
@@ -119,17 +120,16 @@ class StayingInContact:
         to do nonnegative power with its wrench of ``towards`` ``(6, K)`` (the dual's sign is
         the solver's choice), and whether each is not zero."""
         normal_forces = np.asarray(normal_forces, dtype=float)
-        twists = np.asarray(twists, dtype=float)
+        twists, towards = np.asarray(twists, dtype=float), np.asarray(towards, dtype=float)
         words = np.empty((normal_forces.shape[1], self._words), dtype=np.uint64)
-        _PRESSED(normal_forces, self._decided, FRICTION_SET_RTOL, words)
-        key = words.tobytes()
-        last_key, group = self._last
-        if key != last_key:  # (a control loop's cases keep their pressed contacts)
-            group = np.array([self._group(row) for row in words], dtype=np.intp)
-            self._last = (key, group)
         out = np.empty(twists.shape)
         moving = np.empty(twists.shape[1], dtype=np.bool_)
-        _KEPT(twists, self._projections, group, np.asarray(towards, dtype=float), out, moving)
+        last_words, group = self._last
+        if not _KEPT_AS_LAST(normal_forces, self._decided, FRICTION_SET_RTOL, words, last_words,
+                             group, twists, self._projections, towards, out, moving):  # fmt: skip
+            group = np.array([self._group(row) for row in words], dtype=np.intp)
+            self._last = (words, group)
+            _KEPT(twists, self._projections, group, towards, out, moving)
         return out, moving.tolist()
 
     def _group(self, words: np.ndarray) -> int:
@@ -164,6 +164,9 @@ def pressed_contacts(normal, decided, rtol, words):  # pragma: no cover - compil
                 words[j, c // 64] |= np.uint64(1) << np.uint64(c % 64)
 
 
+_PRESSED = compiled_scalar(pressed_contacts)
+
+
 def kept_in_contact(
     twists, projections, group, towards, out, moving
 ):  # pragma: no cover - compiled
@@ -190,6 +193,26 @@ def kept_in_contact(
         moving[j] = False
         for row in range(6):
             moving[j] = moving[j] or out[row, j] != 0.0
+
+
+_KEPT = compiled_scalar(kept_in_contact)
+
+
+def kept_as_last(
+    normal, decided, rtol, words, last_words, group, twists, projections, towards, out, moving
+):  # pragma: no cover - compiled
+    """:func:`pressed_contacts` into ``words``, and where they are ``last_words`` (the groups
+    of the last call are then the same, ``group``), :func:`kept_in_contact`: returns whether it
+    did that."""
+    _PRESSED(normal, decided, rtol, words)
+    if words.shape != last_words.shape:
+        return False
+    for j in range(words.shape[0]):
+        for w in range(words.shape[1]):
+            if words[j, w] != last_words[j, w]:
+                return False
+    _KEPT(twists, projections, group, towards, out, moving)
+    return True
 
 
 def summary(
@@ -231,5 +254,4 @@ def summary(
 _NO_MULTIPLES = np.zeros(0)
 
 _SUMMARY = compiled_scalar(summary)
-_KEPT = compiled_scalar(kept_in_contact)
-_PRESSED = compiled_scalar(pressed_contacts)
+_KEPT_AS_LAST = compiled_scalar(kept_as_last)

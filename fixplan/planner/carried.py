@@ -52,6 +52,10 @@ class Carried:
         #: Where the multiple and the equilibrium's rows sit in the target's x and z.
         self.multiple, self.balance = multiple, balance
         self._pattern = pattern
+        #: What :meth:`carry_at` passes its compiled pass besides the solution: the target's
+        #: compiled maps they were made for, the arguments (the maps, the arrays it fills and
+        #: the pairing) and the arrays ``x``, ``z``, ``q``, A's values and ``b`` among them.
+        self._passed: tuple | None = None
 
     @classmethod
     def between(
@@ -120,23 +124,32 @@ class Carried:
         tested: ``without`` must first see the program), ``x``, ``z`` and the program
         ``(q, A's values, b)``.
 
-        Where ``target`` has dense maps (:meth:`~fixplan.planner.direct_solve.DirectSolver.dense_maps`:
+        Where ``target`` has compiled maps (:meth:`~fixplan.planner.direct_solve.DirectSolver.compiled_maps`:
         the small programs of a control loop) all of it is one compiled pass, which evaluates
-        the program itself."""
-        maps = target.dense_maps()
+        the program itself into arrays kept for the next call (what it returns holds until
+        then: a control loop's analysis reads it at once)."""
+        maps = target.compiled_maps()
         if maps is None:
             q, values, b = target.program(vector)
             alpha, worst, x, z = self.carry(solution, ratio, q, values, b)
             return alpha, worst, -1, x, z, (q, values, b)
-        a_map, q_map, split, b_rows = maps
-        pattern = self._pattern
-        x, z = np.zeros(pattern.column_count), np.zeros(pattern.row_count)
-        q, values, b = np.empty(pattern.column_count), np.empty(split), np.zeros(pattern.row_count)
+        if self._passed is None or self._passed[0] is not maps:
+            a_map, q_map, split, b_rows = maps
+            pattern = self._pattern
+            columns, rows = pattern.column_count, pattern.row_count
+            filled = (np.zeros(columns), np.zeros(rows), np.empty(columns), np.empty(split),
+                      np.zeros(rows))  # fmt: skip
+            x, z, q, values, b = filled
+            arguments = (
+                *a_map, *q_map, split, b_rows, q, values, b, *self._x, *self._z, self.multiple,
+                pattern.rows, pattern.indptr, pattern.zero, pattern.nonneg, pattern.heads,
+                pattern.sizes, x, z,
+            )  # fmt: skip
+            self._passed = (maps, arguments, filled)
+        _, arguments, (x, z, q, values, b) = self._passed
         alpha, worst, held = _CARRIED_AT(
-            vector, a_map, q_map, split, b_rows, q, values, b, solution[0], solution[1],
-            *self._x, *self._z, ratio, self.multiple, pattern.rows, pattern.indptr,
-            pattern.zero, pattern.nonneg, pattern.heads, pattern.sizes, x, z, *without.pass_data,
-        )  # fmt: skip
+            vector, solution[0], solution[1], ratio, *arguments, *without.pass_data
+        )
         return alpha, worst, held, x, z, (q, values, b)
 
 
@@ -214,28 +227,32 @@ _HELD = compiled_scalar(held_without_load)
 
 
 def carried_at(
-    vector, a_map, q_map, split, b_rows, q, values, b, source_x, source_z, x_target, x_source,
-    z_target, z_source, ratio, multiple, rows, indptr, zero, nonneg, heads, sizes, x, z,
-    entries, found, inverse, passive,
+    vector, source_x, source_z, ratio, a_indptr, a_indices, a_data, q_indptr, q_indices, q_data,
+    split, b_rows, q, values, b, x_target, x_source, z_target, z_source, multiple, rows, indptr,
+    zero, nonneg, heads, sizes, x, z, entries, found, inverse, passive,
 ):  # pragma: no cover - compiled  # fmt: skip
-    """:meth:`Carried.carry_at` with dense maps: the program ``q``, ``values`` (A's) and ``b``
-    (zeros) evaluated at ``vector``, then :func:`carried_pair` and, where A's ``entries`` on
-    the passive columns still hold the values ``found`` that ``inverse`` was made from, the
-    point without load (:meth:`WithoutLoad.held`; its passive columns start at ``passive``).
-    Returns ``α``, the largest residual and whether that point is held (-1: not tested)."""
-    for i in range(a_map.shape[0]):
+    """:meth:`Carried.carry_at` with compiled maps (each ``(indptr, indices, data)``): the
+    program ``q``, ``values`` (A's) and ``b`` (zeros but for ``b_rows``) evaluated at ``vector``,
+    then :func:`carried_pair` into ``x`` and ``z`` (set to zeros first) and, where A's
+    ``entries`` on the passive columns still hold the values ``found`` that ``inverse`` was made
+    from, the point without load (:meth:`WithoutLoad.held`; its passive columns start at
+    ``passive``). Returns ``α``, the largest residual and whether that point is held (-1: not
+    tested)."""
+    for i in range(a_indptr.shape[0] - 1):
         total = 0.0
-        for j in range(vector.shape[0]):
-            total += a_map[i, j] * vector[j]
+        for k in range(a_indptr[i], a_indptr[i + 1]):
+            total += a_data[k] * vector[a_indices[k]]
         if i < split:
             values[i] = -total
         else:
             b[b_rows[i - split]] = total
     for i in range(q.shape[0]):
         total = 0.0
-        for j in range(vector.shape[0]):
-            total += q_map[i, j] * vector[j]
+        for k in range(q_indptr[i], q_indptr[i + 1]):
+            total += q_data[k] * vector[q_indices[k]]
         q[i] = total
+    x[:] = 0.0
+    z[:] = 0.0
     alpha, worst = _CARRIED(
         source_x, source_z, x_target, x_source, z_target, z_source, ratio, multiple, q, values,
         rows, indptr, b, zero, nonneg, heads, sizes, x, z,

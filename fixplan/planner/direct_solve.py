@@ -72,6 +72,9 @@ class DirectSolver:
         #: the simplex or the interior-point method with the values it was made from.
         self._constraints = (None, None, None)
         self._dense = (None, None)
+        #: By parameter id, what :meth:`write` needs: its entries in the parameter vector
+        #: (``None``: not used), its shape and whether it enters ``A`` or ``b``.
+        self._placed: dict[int, tuple] = {}
         #: (column of the load multiple, its simplex) where only that column of A changes,
         #: and the last matrix of that simplex with its b.
         self._scaled = None
@@ -165,14 +168,20 @@ class DirectSolver:
         """Put ``parameter``'s ``value`` (broadcast to its shape) into the parameter ``vector``
         (:meth:`parameter_vector`'s layout) instead of into ``parameter``; a parameter that the
         compiled program does not use is left out."""
-        entries = self._program.entries(parameter)
+        placed = self._placed.get(parameter.id)
+        if placed is None:
+            program = self._program
+            placed = (program.entries(parameter), parameter.shape,
+                      program.in_constraints(parameter))  # fmt: skip
+            self._placed[parameter.id] = placed
+        entries, shape, in_constraints = placed
         if entries is None:
             return
         value = np.asarray(value, dtype=float)
-        if value.shape != parameter.shape:  # (broadcast_to costs 5-8 µs; most fit)
-            value = np.broadcast_to(value, parameter.shape)
+        if value.shape != shape:  # (broadcast_to costs 5-8 µs; most fit)
+            value = np.broadcast_to(value, shape)
         vector[entries] = value.ravel(order="F")
-        if vector is self._constraints[0] and self._program.in_constraints(parameter):
+        if in_constraints and vector is self._constraints[0]:
             self._constraints = (None, None, None)
 
     def solve(
@@ -249,13 +258,15 @@ class DirectSolver:
         a, b = self._constraints_at(vector)
         return self._program.cost(vector)[0], a, b
 
-    def dense_maps(self) -> tuple | None:
-        """The program as dense maps of the parameter vector, for compiled passes that evaluate
-        it themselves: ``(a_map, q_map, split, b_rows)``, where ``a_map @ vector`` holds minus
-        ``A``'s values (its first ``split`` entries) and then ``b``'s nonzero entries, at rows
-        ``b_rows`` (zeros elsewhere), and ``(q_map @ vector)[:n]`` is ``q``; ``None`` where a
-        map is sparse (large programs) or ``A`` or ``q`` does not depend on the parameters."""
-        return self._program.dense_maps()
+    def compiled_maps(self) -> tuple | None:
+        """The program of a small problem as maps of the parameter vector, for compiled passes
+        that evaluate it themselves: ``(a_map, q_map, split, b_rows)``, each map compressed by
+        rows (``(indptr, indices, data)``), where ``a_map @ vector`` holds minus ``A``'s values
+        (its first ``split`` entries) and then ``b``'s nonzero entries, at rows ``b_rows``
+        (zeros elsewhere), and ``(q_map @ vector)[:n]`` is ``q``; ``None`` for large programs
+        (whose maps numpy applies faster) or where ``A`` or ``q`` does not depend on the
+        parameters."""
+        return self._program.compiled_maps()
 
     def _constraints_at(self, vector: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``A``'s values and ``b`` at ``vector``, kept while the same ``vector`` object holds
@@ -434,6 +445,11 @@ class _Program:
                     (placed.data, (rows, placed.col)), shape=(self._a_shape[0], self._size)
                 )
             )
+        self._compiled_maps = None
+        small = isinstance(self._a_map, np.ndarray) and isinstance(self._q, np.ndarray)
+        if small and self._fixed_values is None and self._fixed_cost is None:
+            self._compiled_maps = (_by_rows(a_map), _by_rows(q_map), self._split,
+                                   self._a_rows[self._split :])  # fmt: skip
         if program.reduced_P is None or program.reduced_P.matrix_data is None:
             self.quadratic = sp.csc_matrix((self.variables, self.variables))
             self.parametric_p = False
@@ -468,12 +484,9 @@ class _Program:
         full = self._q.dot(vector)
         return full[: self.variables], float(full[self.variables])
 
-    def dense_maps(self) -> tuple | None:
-        """See :meth:`DirectSolver.dense_maps`."""
-        dense = isinstance(self._a_map, np.ndarray) and isinstance(self._q, np.ndarray)
-        if not dense or self._fixed_values is not None or self._fixed_cost is not None:
-            return None
-        return self._a_map, self._q, self._split, self._a_rows[self._split :]
+    def compiled_maps(self) -> tuple | None:
+        """See :meth:`DirectSolver.compiled_maps`."""
+        return self._compiled_maps
 
     def constraints(self, vector) -> tuple[np.ndarray, np.ndarray]:
         """Clarabel's ``A`` as its values in the fixed pattern (:meth:`matrix`) and ``b``:
@@ -521,6 +534,14 @@ def _for_products(matrix: sp.csr_array):
     """``matrix`` as it is fastest to multiply (with ``.dot``, 1 µs less than ``@`` on small
     arrays): dense up to ``DENSE_MAX_ENTRIES`` entries."""
     return matrix.toarray() if matrix.shape[0] * matrix.shape[1] <= DENSE_MAX_ENTRIES else matrix
+
+
+def _by_rows(matrix: sp.csr_array) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``matrix``'s ``(indptr, indices, data)``, its explicit zeros left out."""
+    matrix = sp.csr_array(matrix, copy=True)
+    matrix.eliminate_zeros()
+    return (matrix.indptr.astype(np.intp), matrix.indices.astype(np.intp),
+            matrix.data.astype(float))  # fmt: skip
 
 
 def _constraint_rows(inverse_data: dict) -> dict:

@@ -292,11 +292,13 @@ class Runner:
         kept = self._written(key, wrenches, given, 1.0, None, disabled)
         if kept is None:
             return {}
-        direct, without = self._direct[key], self._without(key)
+        direct, without = self._direct[key], self._without_load.get(key) or self._without(key)
         ends = {}
         source, unit = self._source or (None, 1.0)
         forces_solved = source is not None and source[0] not in FIXED_FORCE_OBJECTIVES
-        carried = self._carried(source) if forces_solved else None
+        carried = None
+        if forces_solved:
+            carried = self._carry[source] if source in self._carry else self._carried(source)
         held = -1  # (not tested yet)
         if carried is not None:
             solution, ratio = self._direct[source].solution, unit / kept.unit
@@ -706,8 +708,10 @@ def _given_state(given: dict) -> tuple | None:
     """Given forces that are plain numbers as a comparable tuple; ``None`` if any is an array."""
     if not given:
         return ()
-    scalars = tuple((i, v) for i, v in given.items() if isinstance(v, float))
-    return scalars if len(scalars) == len(given) else None
+    for value in given.values():
+        if not isinstance(value, float):
+            return None
+    return tuple(given.items())
 
 
 def _linear(model) -> bool:

@@ -8,7 +8,6 @@ angular velocity ``ω`` [rad/s]. Its screw is the axis along ``ω`` through the 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -27,9 +26,12 @@ def _fmt(vector: np.ndarray, noise: float, digits: int = 4) -> str:
     return "(" + ", ".join(f"{x:.{digits}g}" for x in cleaned + 0.0) + ")"
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
 class Screw:
     """A unit twist and its screw.
+
+    Built from a twist in a fraction of a microsecond: the unit twist and the axis are worked
+    out on first use (a controller that reads only the forces of its plans pays nothing for
+    their motions).
 
     Attributes
     ----------
@@ -46,37 +48,49 @@ class Screw:
         The body's length scale [m]; sets what counts as solver noise when printing.
     """
 
-    twist: np.ndarray
-    direction: np.ndarray
-    point: np.ndarray | None
-    pitch: float
-    length_scale: float = 1.0
+    __slots__ = ("_axis", "_given", "length_scale")
+
+    def __init__(self, twist: np.ndarray, length_scale: float):
+        """The screw of a nonzero, finite ``twist`` ``(6,)``, kept as it is (not to be changed
+        afterwards: :meth:`from_twist` checks and copies it); ``length_scale`` [m] sets the
+        translation test."""
+        self._given = twist
+        self.length_scale = length_scale
+        self._axis: tuple | None = None
 
     @classmethod
-    def from_twist(cls, twist: np.ndarray, length_scale: float) -> Screw:
-        """The screw of ``twist`` ``(6,)``; ``length_scale`` [m] sets the translation test."""
-        # In floats: numpy's calls cost more than the arithmetic on six numbers (14 µs → 4 µs).
-        vx, vy, vz, wx, wy, wz = np.asarray(twist, dtype=float).tolist()
-        norm = math.sqrt(
-            vx * vx + vy * vy + vz * vz + length_scale**2 * (wx * wx + wy * wy + wz * wz)
-        )
-        vx, vy, vz, wx, wy, wz = vx / norm, vy / norm, vz / norm, wx / norm, wy / norm, wz / norm
-        speed = math.sqrt(vx * vx + vy * vy + vz * vz)
-        spin = math.sqrt(wx * wx + wy * wy + wz * wz)
-        # (One array for all three vectors: each np.array of a list costs about 1 µs.)
-        if spin * length_scale <= TRANSLATION_RTOL * speed:
-            values = np.array([vx, vy, vz, 0.0, 0.0, 0.0, vx / speed, vy / speed, vz / speed])
-            return cls(twist=values[:6], direction=values[6:], point=None, pitch=float("inf"),
-                       length_scale=length_scale)  # fmt: skip
-        squared = spin * spin  # the point ω × v / |ω|² and the pitch ω·v / |ω|²
-        values = np.array([
-            vx, vy, vz, wx, wy, wz, wx / spin, wy / spin, wz / spin,
-            (wy * vz - wz * vy) / squared, (wz * vx - wx * vz) / squared,
-            (wx * vy - wy * vx) / squared,
-        ])  # fmt: skip
-        return cls(twist=values[:6], direction=values[6:9], point=values[9:],
-                   pitch=(wx * vx + wy * vy + wz * vz) / squared,
-                   length_scale=length_scale)  # fmt: skip
+    def from_twist(cls, twist, length_scale: float) -> Screw:
+        """The screw of ``twist`` ``(6,)`` (a copy is kept); ``length_scale`` [m] sets the
+        translation test."""
+        values = np.array(twist, dtype=float)
+        if values.shape != (6,) or not np.isfinite(values).all() or not values.any():
+            raise ValueError(f"a screw needs a nonzero, finite twist of 6 numbers, not {twist!r}")
+        return cls(values, float(length_scale))
+
+    def __repr__(self) -> str:
+        return f"Screw.from_twist({self.twist.tolist()}, {self.length_scale!r})"
+
+    @property
+    def twist(self) -> np.ndarray:
+        return self._unit_twist_and_axis()[0]
+
+    @property
+    def direction(self) -> np.ndarray:
+        return self._unit_twist_and_axis()[1]
+
+    @property
+    def point(self) -> np.ndarray | None:
+        return self._unit_twist_and_axis()[2]
+
+    @property
+    def pitch(self) -> float:
+        return self._unit_twist_and_axis()[3]
+
+    def _unit_twist_and_axis(self) -> tuple:
+        """``(twist, direction, point, pitch)``, worked out once."""
+        if self._axis is None:
+            self._axis = _unit_twist_and_axis(self._given, self.length_scale)
+        return self._axis
 
     @property
     def is_translation(self) -> bool:
@@ -103,3 +117,25 @@ class Screw:
             "pitch_m_per_rad": None if self.is_translation else self.pitch,
             "words": self.describe(),
         }
+
+
+def _unit_twist_and_axis(twist: np.ndarray, length_scale: float) -> tuple:
+    """``(unit twist, direction, point or None, pitch)`` of a nonzero ``twist`` ``(6,)`` (see
+    :class:`Screw`)."""
+    # In floats: numpy's calls cost more than the arithmetic on six numbers (14 µs → 4 µs).
+    vx, vy, vz, wx, wy, wz = np.asarray(twist, dtype=float).tolist()
+    norm = math.sqrt(vx * vx + vy * vy + vz * vz + length_scale**2 * (wx * wx + wy * wy + wz * wz))
+    vx, vy, vz, wx, wy, wz = vx / norm, vy / norm, vz / norm, wx / norm, wy / norm, wz / norm
+    speed = math.sqrt(vx * vx + vy * vy + vz * vz)
+    spin = math.sqrt(wx * wx + wy * wy + wz * wz)
+    # (One array for all three vectors: each np.array of a list costs about 1 µs.)
+    if spin * length_scale <= TRANSLATION_RTOL * speed:
+        values = np.array([vx, vy, vz, 0.0, 0.0, 0.0, vx / speed, vy / speed, vz / speed])
+        return values[:6], values[6:], None, float("inf")
+    squared = spin * spin  # the point ω × v / |ω|² and the pitch ω·v / |ω|²
+    values = np.array([
+        vx, vy, vz, wx, wy, wz, wx / spin, wy / spin, wz / spin,
+        (wy * vz - wz * vy) / squared, (wz * vx - wx * vz) / squared,
+        (wx * vy - wy * vx) / squared,
+    ])  # fmt: skip
+    return values[:6], values[6:9], values[9:], (wx * vx + wy * vy + wz * vz) / squared

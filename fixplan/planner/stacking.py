@@ -398,16 +398,17 @@ def set_given(stacked: Stacked, values: dict, unit: float = 1.0, put: Callable =
     value)`` (default :func:`~fixplan.planner.parameters.assign`)."""
     fingers, clamps = stacked.given_fingers, stacked.given_clamps
     finger_values = None if fingers is None else np.zeros(fingers.shape)
-    clamp_values = None if clamps is None else np.zeros(clamps.shape)
+    # (The clamps' in floats: numpy's calls cost more than the arithmetic.)
+    clamp_values = None if clamps is None else [0.0] * clamps.shape[0]
     for i, (kind, row) in stacked.given.items():
         # A planned force may come back from the solver as -1e-12 N: given forces are >= 0.
         value = values[i]
         if kind == "finger":
             finger_values[row] = np.maximum(value, 0.0) / unit
-        else:  # (in floats: numpy's calls cost more than the arithmetic)
+        else:
             first = value if isinstance(value, float) else float(np.ravel(value)[0])
             clamp_values[row] = max(first, 0.0) / unit
     if fingers is not None:
         put(fingers, finger_values)
     if clamps is not None:
-        put(clamps, clamp_values)
+        put(clamps, np.array(clamp_values))
