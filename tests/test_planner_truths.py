@@ -363,10 +363,47 @@ def test_random_grasps_are_held_exactly_where_the_reference_holds_them(problem):
     if min(abs(0.5 - low), abs(0.5 - top)) > EDGE_RTOL:
         probes[0.5] = low <= 0.5 <= high
     for k, held in probes.items():
-        try:
-            assert ref.feasible(problem, 0, None, k) is held, (k, (low, high))
+        try:  # (strict: a probe 1e-6 from an end is decided at the reference's own tolerances)
+            assert ref.feasible(problem, 0, None, k, strict=True) is held, (k, (low, high))
         except ref.ReferenceSolveError:
             continue  # the reference cannot decide so close to an end
+
+
+def test_an_ill_conditioned_grasp_ends_where_the_reference_ends_it():
+    """A three-finger grasp (found by the test above) whose held interval ends where the
+    reference's strict feasibility solve is inaccurate for 1e-6 around it; its retry at looser
+    tolerances held 1.5e-6 beyond (and inside, its strict solve decides only from 3e-4 on, on
+    these very numbers). The planner's end is the reference's optimum, and probes that the
+    strict solve decides with a margin (1e-2 inside, 1e-4 outside) fall on their sides."""
+    fingers = [
+        ([-0.02069842277056954, -0.00998758788942778, 0.033311322393314226],
+         [0.14133094783069966, 0.40965398321777374, -0.9012264849742755], 0.2008,
+         16.513339769463844),
+        ([0.07024453645269474, 0.0062312326124567075, -0.00805036070364734],
+         [-0.8191916222459137, -0.4365193147358852, 0.37198921208097063], 0.30560000000000004,
+         9.599542175734008),
+        ([-0.054056919405190446, 0.004112487750664487, -0.024614268214762855],
+         [0.4733081127371973, -0.21629865710348442, 0.8539287566023185], 0.64,
+         13.831602973321681),
+    ]  # fmt: skip
+    problem = Problem(
+        body=Body(mass=0.09680000000000001, center_of_mass=[0.0, 0.0, 0.0]),
+        contacts=[
+            Contact(name=f"finger-{i + 1}", role="finger", position=position, normal=normal,
+                    mu=mu, model="point-cone", force=force)
+            for i, (position, normal, mu, force) in enumerate(fingers)
+        ],
+        loads=[Load(name="task", force=[-0.7363941341093964, -0.1047165970522536,
+                                        -0.13005125762941178],
+                    point=[-0.025998450000000003, 0.002494149999999999, -0.008584])],
+        objective="check",
+    )  # fmt: skip
+    low, high = fixplan.solve(problem).held_intervals["task"]
+    expected = ref.held_interval(problem, 0, None, k_max=MAX_SAFETY_FACTOR)
+    assert_same_interval((low, high), expected)
+    assert low == 0.0 and high == pytest.approx(expected[1], rel=1e-8)
+    assert ref.feasible(problem, 0, None, high * (1 - 1e-2), strict=True)
+    assert not ref.feasible(problem, 0, None, high * (1 + 1e-4), strict=True)
 
 
 #: A finger whose utilisation is below this has friction to spare: it sticks.
