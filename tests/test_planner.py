@@ -9,6 +9,7 @@ import pytest
 from fixplan import LimitSurface, pressure
 from fixplan.errors import FixplanError, InvalidArgumentError
 from fixplan.models import Ellipsoid
+from fixplan.planner.certificate import certificate
 from fixplan.planner.contact_surface import ContactSetSurface
 from fixplan.planner.planner import Planner, solve
 from fixplan.planner.problem import Body, Contact, Load, Problem, ProblemError
@@ -78,6 +79,15 @@ def test_torque_about_the_axis_of_a_point_contact_pinch_is_infeasible_with_that_
     assert abs(motion.direction @ [0, 1, 0]) == pytest.approx(1.0, abs=1e-6)
     assert np.linalg.norm(motion.point) < 1e-6
     assert "'twist' cannot be held" in plan.certificate
+
+
+def test_a_certificate_leaves_out_a_case_whose_twist_is_not_finite():
+    dual = np.array([[0.0, 0.0, 0.0, 0.0, 1.0, 0.0], [np.nan] * 6]).T
+    wrenches = np.array([[0.0, 0.0, 0.0, 0.0, 1.0, 0.0]] * 2).T
+    motions, words = certificate(("twist", "broken"), dual, wrenches, wrenches,
+                                 fixed_forces=False, length_scale=0.05)  # fmt: skip
+    assert list(motions) == ["twist"] and "'broken'" not in words
+    assert motions["twist"].direction @ [0, 1, 0] == pytest.approx(1.0)
 
 
 def block_on_plate(patch, model, push):

@@ -2,6 +2,7 @@
 with pitch ``h`` has ``v = p × ω + h ω`` (the velocity of the body point at the origin)."""
 
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -59,3 +60,27 @@ def test_a_screw_keeps_a_copy_of_its_twist_and_its_repr_makes_it_again():
 def test_a_twist_without_a_screw_is_refused(twist):
     with pytest.raises(ValueError, match="nonzero, finite twist of 6 numbers"):
         Screw.from_twist(twist, LENGTH_SCALE)
+
+
+@pytest.mark.parametrize("protocol", range(pickle.HIGHEST_PROTOCOL + 1))
+def test_a_screw_pickles_with_every_protocol(protocol):
+    screw = Screw.from_twist(twist_of([1, 2, 3], [0.01, -0.02, 0.0], 0.003, 2.0), LENGTH_SCALE)
+    again = pickle.loads(pickle.dumps(screw, protocol=protocol))
+    np.testing.assert_array_equal(again.twist, screw.twist)
+    assert again.describe() == screw.describe()
+
+
+@pytest.mark.parametrize("size", [1e-300, 1e300])
+def test_the_screw_of_a_tiny_or_huge_twist_is_that_of_its_direction(size):
+    twist = twist_of([0, 1, 1], [0.02, 0.0, 0.0], 0.01, 1.0)
+    screw = Screw(twist * size, LENGTH_SCALE)  # (as the analysis makes them: not checked)
+    expected = Screw.from_twist(twist, LENGTH_SCALE)
+    np.testing.assert_allclose(screw.twist, expected.twist, rtol=2e-15)
+    np.testing.assert_allclose(screw.point, [0.02, 0.0, 0.0], rtol=0, atol=1e-15)
+
+
+def test_the_screw_of_a_subnormal_twist_is_a_unit_twist():
+    """(Its entries hold a few bits: only the scaling is checked.)"""
+    screw = Screw(twist_of([0, 1, 1], [0.02, 0.0, 0.0], 0.01, 1.0) * 1e-320, LENGTH_SCALE)
+    v, w = screw.twist[:3], screw.twist[3:]
+    assert v @ v + LENGTH_SCALE**2 * (w @ w) == pytest.approx(1.0, rel=1e-14)

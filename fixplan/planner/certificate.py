@@ -29,11 +29,12 @@ def certificate(
     """
     if dual is None:
         return {}, "the problem is infeasible (the solver gave no certificate)"
-    size = np.abs(dual).max()
+    finite = np.isfinite(dual).all(axis=0)  # (a case without a certificate: not reported)
+    size = np.abs(dual[:, finite]).max(initial=0.0)
     motions, lines = {}, []
     for j, name in enumerate(names):
         twist = dual[:, j]
-        if size == 0.0 or np.abs(twist).max() <= 1e-6 * size:
+        if not finite[j] or size == 0.0 or np.abs(twist).max() <= 1e-6 * size:
             continue
         power = applied[:, j] @ twist
         if abs(power) <= 1e-9 * np.abs(applied[:, j]).max(initial=0.0) * np.abs(twist).max():

@@ -70,6 +70,9 @@ class Screw:
     def __repr__(self) -> str:
         return f"Screw.from_twist({self.twist.tolist()}, {self.length_scale!r})"
 
+    def __reduce__(self) -> tuple:
+        return Screw, (self._given, self.length_scale)
+
     @property
     def twist(self) -> np.ndarray:
         return self._unit_twist_and_axis()[0]
@@ -123,7 +126,9 @@ def _unit_twist_and_axis(twist: np.ndarray, length_scale: float) -> tuple:
     """``(unit twist, direction, point or None, pitch)`` of a nonzero ``twist`` ``(6,)`` (see
     :class:`Screw`)."""
     # In floats: numpy's calls cost more than the arithmetic on six numbers (14 µs → 4 µs).
-    vx, vy, vz, wx, wy, wz = np.asarray(twist, dtype=float).tolist()
+    entries = np.asarray(twist, dtype=float).tolist()
+    largest = max(map(abs, entries))  # (divided by first: no squares under- or overflow)
+    vx, vy, vz, wx, wy, wz = (x / largest for x in entries)
     norm = math.sqrt(vx * vx + vy * vy + vz * vz + length_scale**2 * (wx * wx + wy * wy + wz * wz))
     vx, vy, vz, wx, wy, wz = vx / norm, vy / norm, vz / norm, wx / norm, wy / norm, wz / norm
     speed = math.sqrt(vx * vx + vy * vy + vz * vz)
