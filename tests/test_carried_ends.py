@@ -9,6 +9,7 @@ import pytest
 import reference_planner as ref
 from test_kept_parameters import bench_fixture, path
 
+from fixplan import pressure
 from fixplan.planner.planner import Planner
 from fixplan.planner.problem import Body, Contact, Load, Problem
 from fixplan.planner.runner import Runner
@@ -243,3 +244,71 @@ def test_an_end_not_carried_is_solved_in_the_vector_just_written(model, monkeypa
         if solved[-1]:
             assert_interval(plan.held_intervals["cut"], reference_interval(problem, plan, load[0]))
     assert any(solved)
+
+
+@pytest.fixture
+def osculated(monkeypatch):
+    """The ends that each analysis of an exact model carried (``Runner._osculated_ends``)."""
+    found = []
+    carried = Runner._osculated_ends
+
+    def counted(self, *args):
+        result = carried(self, *args)
+        found.append({end: float(value["scale"][0]) for end, value in result.items()})
+        return result
+
+    monkeypatch.setattr(Runner, "_osculated_ends", counted)
+    return found
+
+
+def test_exact_models_carry_the_ends_their_check_solves_find(osculated, monkeypatch):
+    """On the fixture with exact models, the settled force solve carried into check's
+    osculating program gives the held intervals, motions (to the duals' accuracy) and
+    utilisation (where ``k_max`` is below the cap, past which the loads are anywhere in a face of
+    optima) that check's own rounds find (a planner whose carry is switched off), along a
+    turning cut."""
+    loads = path(14)
+    problem = bench_fixture(loads[0], "exact")
+    carrying, solving = Planner(problem), Planner(problem)
+    for load in loads[:3]:  # (the direct solvers of the force objective and of check)
+        carrying.solve(load)
+        solving.solve(load)
+    osculated.clear()
+    found = []
+    for load in loads[3:]:
+        found.append(carrying.solve(load))
+    monkeypatch.setattr(Runner, "_osculated_ends", lambda self, *args: {})
+    for plan, load in zip(found, loads[3:], strict=True):
+        expected = solving.solve(load)
+        assert plan.status == expected.status == "optimal"
+        assert plan.forces["clamp-top"] == pytest.approx(expected.forces["clamp-top"], rel=1e-9)
+        np.testing.assert_allclose(plan.held_intervals["cut"], expected.held_intervals["cut"],
+                                   rtol=1e-7, atol=1e-9)  # fmt: skip
+        motion, other = plan.motions["cut"], expected.motions["cut"]
+        assert (motion is None) is (other is None)
+        if motion is not None:  # (interior-point duals: up to 2.1e-4 apart on the whole path)
+            assert np.linalg.norm(motion.twist - other.twist) <= 1e-3 * np.linalg.norm(other.twist)
+        if np.isfinite(expected.held_intervals["cut"][1]):  # (at the cap: a face of optima)
+            np.testing.assert_allclose(plan.utilisation, expected.utilisation, rtol=0, atol=1e-6)
+    assert all(ends.get("lowest") == 0.0 for ends in osculated)  # (held without the cut)
+    assert sum("highest" in ends for ends in osculated) >= len(loads[3:]) // 2
+
+
+def test_an_exact_lift_that_helps_the_grip_is_carried_from_one_up(osculated):
+    """:func:`lift_helping_a_pinch` with exact disk patches: a pure force's friction limit is
+    ``mu`` times the normal force whatever the pressure, so the closed forms hold, and the lower
+    end, 1, is carried from the force solve (the multiple minimised)."""
+    problem = lift_helping_a_pinch(4.0)
+    patch = pressure.disk(0.005)
+    problem = dataclasses.replace(problem, contacts=[
+        dataclasses.replace(c, model="exact", patch=patch) for c in problem.contacts
+    ])  # fmt: skip
+    weight = -problem.body.weight_wrench[2]
+    planner = Planner(problem)
+    for lift in (4.0, 4.5, 5.0, 3.0, 4.0):
+        plan = planner.solve([dataclasses.replace(problem.loads[0], force=[0, 0, lift])])
+        assert plan.forces["left"] == pytest.approx((weight - lift) / 2 / 0.5, rel=1e-7)
+        low, high = plan.held_intervals["lift"]
+        assert low == pytest.approx(1.0, rel=1e-7)
+        assert high == pytest.approx((2 * weight - lift) / lift, rel=1e-7)
+    assert {"lowest": 1.0} in osculated[-2:]

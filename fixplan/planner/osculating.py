@@ -171,6 +171,8 @@ class OsculatingPool(ExactContacts):
         self._next_slot = np.zeros((count, cases), dtype=int)
         #: ``(E, K)`` the excess of each pair's load in the last round of this solve (NaN: none).
         self._previous_excess = np.full((count, cases), np.nan)
+        #: The ellipsoids and cut planes of the last solve (before :meth:`move` moved them).
+        self._solved_with = (self._factors.copy(), self._planes.copy())
         self._entries = [(r, c) for r in range(3) for c in range(r, 3)]  # upper triangle
         self._parameters = [
             cp.Parameter((count, cases), name=f"osculating_{r}{c}") for r, c in self._entries
@@ -196,6 +198,13 @@ class OsculatingPool(ExactContacts):
                 self._factors[:, j] = factors
         self._assign()
 
+    def follow(self, other: OsculatingPool) -> None:
+        """Take the ellipsoids and cuts of ``other``'s last solve (a pool of the same exact
+        contacts and load cases)."""
+        factors, planes = other._solved_with
+        self._factors[:], self._planes[:] = factors, planes
+        self._assign()
+
     def converge(self, solve: Callable[[], str], status: str) -> tuple[str, bool]:
         """Move the ellipsoids and re-solve (``solve()`` returns the status) from a first
         solve's ``status``; the final status and whether the rounds settled on the exact
@@ -212,6 +221,7 @@ class OsculatingPool(ExactContacts):
     def move(self) -> bool:
         """Put each ellipsoid where its contact's solved load meets the exact set; whether the
         solve already met the exact problem's optimality conditions (see the module)."""
+        self._solved_with = (self._factors.copy(), self._planes.copy())
         normal = self._normal_values()
         friction = np.asarray(self._friction.value, dtype=float)
         forces = normal[self._contacts]  # (E, K)

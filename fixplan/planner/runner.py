@@ -85,6 +85,9 @@ class Runner:
         #: solve went through cvxpy), and the maps of its optimum into ``check``'s (see
         #: :meth:`carried_ends`, :meth:`held_without_load`).
         self._source: tuple | None = None
+        #: The key of the program whose last solve went through its direct solver (``None``:
+        #: through cvxpy); an osculating program settled so is a source too.
+        self._directly: tuple | None = None
         self._carry: dict[tuple, Carried | None] = {}
         self._without_load: dict[tuple, WithoutLoad] = {}
         # Task torques over the longest lever [m] of a contact's normal force are forces.
@@ -289,6 +292,8 @@ class Runner:
         key = ("check", False)
         if wrenches.shape[1] != 1:
             return {}
+        if self._source is not None and self._source[0][1]:
+            return self._osculated_ends(wrenches, given, disabled)
         kept = self._written(key, wrenches, given, 1.0, None, disabled)
         if kept is None:
             return {}
@@ -348,18 +353,59 @@ class Runner:
         return self._without_load[key]
 
     def _carried(self, source: tuple) -> Carried | None:
-        """The map from ``source``'s program to ``check``'s (built once)."""
-        key = ("check", False)
+        """The map from ``source``'s program to ``check``'s of the same kind (osculating or not;
+        built once)."""
+        key = ("check", source[1])
         if source not in self._carry:
             if key not in self._readers:
                 self._readers[key] = Reader.of(self._built[key], self._direct[key])
             carried = None
-            if self._readers[key] is not None:  # (else its answers are read through cvxpy)
+            # (Else its answers are read through cvxpy; an osculating program's always are.)
+            if self._readers[key] is not None or source[1]:
                 carried = Carried.between(
                     self._built[source], self._direct[source], self._built[key], self._direct[key]
                 )
             self._carry[source] = carried
         return self._carry[source]
+
+    def _osculated_ends(self, wrenches: np.ndarray, given: dict, disabled=None) -> dict:
+        """:meth:`carried_ends` after a force solve of osculating ellipsoids that settled in a
+        direct solve: its optimum carried into ``check``'s osculating program, set with the
+        ellipsoids and cuts of that solve's last round. Where the pair is optimal there, it is
+        at the exact problem's too: the settled loads and twists, which met the exact problem's
+        optimality conditions, are the pair's (the twists scaled by ``α > 0``, and the tests
+        of :mod:`~fixplan.planner.osculating` weigh twists relative to the largest). The point
+        without load has no friction, which every exact set holds. (No ``"solved"``: ``check``
+        is solved in its rounds.)"""
+        (source, unit), key = self._source, ("check", True)
+        direct = self._direct.get(key)
+        if direct is None or self._direct.get(source) is None:
+            return {}  # (``check`` has had no direct solve yet)
+        stacked = self.stacked(*key)
+        check_unit = self._force_unit(wrenches, given)
+        stacked.exact.follow(self._built[source].exact)
+        carried = self._carried(source)
+        if carried is None:
+            return {}
+        ends = {}
+        for sense in (1.0, -1.0):  # (the other end where the multiple is minimised: α < 0)
+            self._set_parameters(key, stacked, wrenches / check_unit, given, sense, None,
+                                 disabled, check_unit)  # fmt: skip
+            q, values, b = direct.program(direct.parameter_vector())
+            alpha, worst, _, z = carried.carry(
+                self._direct[source].solution, unit / check_unit, q, values, b
+            )
+            if worst <= CERTIFICATE_RTOL and sense > 0.0:
+                ends["highest"] = {"status": "optimal", "solver": "carried from the force solve",
+                                   "warnings": [], "scale": np.array([1.0]),
+                                   "dual": z[carried.balance][:, None] / check_unit}  # fmt: skip
+            elif worst <= CERTIFICATE_RTOL:
+                ends["lowest"] = {"status": "optimal", "scale": np.ones(1)}
+            if alpha >= 0.0:
+                break
+        if "lowest" not in ends and self._without(key).held(values, b):
+            ends["lowest"] = {"status": "optimal", "scale": np.zeros(1)}
+        return ends
 
     def with_sense(self, objective, wrenches, given, sense, disabled=None) -> dict | None:
         """The fixed-force ``objective`` solved again with ``sense`` where the parameter
@@ -523,6 +569,8 @@ class Runner:
                 # Settled: the loads meet the exact problem's optimality conditions, checked
                 # here whatever the solver said of its accuracy.
                 solver = f"{self.solver} (osculating ellipsoids)"
+                if self._directly == key:  # (its optimum is the direct solver's: carried_ends)
+                    self._source = (key, unit)
                 return in_newtons(self._result(stacked, "optimal", solver, notes), unit, objective)
             solver = self.solver
             if status in ("solver-error", "inaccurate") and not fallback:
@@ -606,7 +654,9 @@ class Runner:
         def once() -> str:
             nonlocal direct
             use, direct = direct and not accurate and solver == self.solver, True
+            self._directly = None
             if use and self._direct_into(key, stacked):
+                self._directly = key
                 return "optimal"
             status = call(stacked.problem, solver, accurate=accurate)
             if status == "optimal" and solver == self.solver:
