@@ -13,6 +13,7 @@ last padded), and a fixture whose passive locators face each other (squeezes unl
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -257,3 +258,35 @@ def test_a_warm_re_solve_leaves_no_limiting_load_inside_its_set(monkeypatch):
         assert plan.solver == "CLARABEL (osculating ellipsoids)"
         assert plan.objective_value == pytest.approx(reference.objective_value, rel=OPTIMUM_RTOL)
         assert_loads_inside_their_exact_surfaces(problem, plan)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_warm_single_case_re_solves_carry_the_cutting_planes_held_intervals(seed, monkeypatch):
+    """A warm planner's analysis of a single load case carries the settled force solve into
+    check's osculating program (:meth:`~fixplan.planner.runner.Runner._osculated_ends`):
+    re-solves of a random single-case pinch with new loads agree with the cutting planes."""
+    carried = []
+    osculated = runner.Runner._osculated_ends
+    monkeypatch.setattr(runner.Runner, "_osculated_ends",
+                        lambda self, *args: carried.append(osculated(self, *args)) or carried[-1])  # fmt: skip
+    names = [*PATCHES, "combined"]
+
+    def problem_of(number):
+        rng = np.random.default_rng(number)
+        patches = [names[i] for i in rng.choice(len(names), 2)]
+        objective = ("min-max-normal-force", "min-total-clamp-force")[seed % 2]
+        return pinch(rng, patches, objective, cases=1)
+
+    problem = problem_of(200 + seed)
+    new_loads = [problem_of(20_000 + 10 * seed + j).loads for j in range(5)]
+    warm = Planner(problem)
+    plans = [warm.solve(), *(warm.solve(loads) for loads in new_loads)]
+    with monkeypatch.context() as patch:
+        patch.setattr(runner, "smooth", lambda models: False)
+        cutting = Planner(problem)
+        references = [cutting.solve(), *(cutting.solve(loads) for loads in new_loads)]
+    for plan, reference, loads in zip(plans, references, [problem.loads, *new_loads],
+                                      strict=True):  # fmt: skip
+        assert_same_plans(dataclasses.replace(problem, loads=loads), plan, reference,
+                          planar_motion=False)  # fmt: skip
+    assert sum("highest" in ends for ends in carried) >= 3, carried
