@@ -379,8 +379,8 @@ class Runner:
         is solved in its rounds.)"""
         (source, unit), key = self._source, ("check", True)
         direct = self._direct.get(key)
-        if direct is None or self._direct.get(source) is None:
-            return {}  # (``check`` has had no direct solve yet)
+        if source[0] in FIXED_FORCE_OBJECTIVES or direct is None or self._direct.get(source) is None:
+            return {}  # (not a force solve, or ``check`` has had no direct solve yet)
         stacked = self.stacked(*key)
         check_unit = self._force_unit(wrenches, given)
         stacked.exact.follow(self._built[source].exact)
