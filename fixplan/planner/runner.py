@@ -379,7 +379,11 @@ class Runner:
         is solved in its rounds.)"""
         (source, unit), key = self._source, ("check", True)
         direct = self._direct.get(key)
-        if source[0] in FIXED_FORCE_OBJECTIVES or direct is None or self._direct.get(source) is None:
+        if (
+            source[0] in FIXED_FORCE_OBJECTIVES
+            or direct is None
+            or self._direct.get(source) is None
+        ):
             return {}  # (not a force solve, or ``check`` has had no direct solve yet)
         stacked = self.stacked(*key)
         check_unit = self._force_unit(wrenches, given)
