@@ -190,8 +190,9 @@ def lift_helping_a_pinch(lift: float) -> Problem:
     return Problem(body=body, contacts=fingers, loads=[load], objective="min-max-normal-force")
 
 
-def test_a_lift_that_helps_the_grip_holds_from_one_up(ends):
-    problem = lift_helping_a_pinch(4.0)
+def assert_lifts_held_from_one_up(problem: Problem) -> None:
+    """Re-solves of :func:`lift_helping_a_pinch` (or its fingers on other models) with several
+    lifts give the closed-form forces and held intervals."""
     weight = -problem.body.weight_wrench[2]
     planner = Planner(problem)
     for lift in (4.0, 4.5, 5.0, 3.0, 4.0):
@@ -200,6 +201,10 @@ def test_a_lift_that_helps_the_grip_holds_from_one_up(ends):
         low, high = plan.held_intervals["lift"]
         assert low == pytest.approx(1.0, rel=1e-7)
         assert high == pytest.approx((2 * weight - lift) / lift, rel=1e-7)
+
+
+def test_a_lift_that_helps_the_grip_holds_from_one_up(ends):
+    assert_lifts_held_from_one_up(lift_helping_a_pinch(4.0))
     assert ("lowest",) in ends[-2:]  # carried where the direct solvers were there
 
 
@@ -303,12 +308,5 @@ def test_an_exact_lift_that_helps_the_grip_is_carried_from_one_up(osculated):
     problem = dataclasses.replace(problem, contacts=[
         dataclasses.replace(c, model="exact", patch=patch) for c in problem.contacts
     ])  # fmt: skip
-    weight = -problem.body.weight_wrench[2]
-    planner = Planner(problem)
-    for lift in (4.0, 4.5, 5.0, 3.0, 4.0):
-        plan = planner.solve([dataclasses.replace(problem.loads[0], force=[0, 0, lift])])
-        assert plan.forces["left"] == pytest.approx((weight - lift) / 2 / 0.5, rel=1e-7)
-        low, high = plan.held_intervals["lift"]
-        assert low == pytest.approx(1.0, rel=1e-7)
-        assert high == pytest.approx((2 * weight - lift) / lift, rel=1e-7)
+    assert_lifts_held_from_one_up(problem)
     assert {"lowest": 1.0} in osculated[-2:]
