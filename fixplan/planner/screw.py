@@ -75,21 +75,21 @@ class Screw:
 
     @property
     def twist(self) -> np.ndarray:
-        return self._unit_twist_and_axis()[0]
+        return self._worked_out()[0]
 
     @property
     def direction(self) -> np.ndarray:
-        return self._unit_twist_and_axis()[1]
+        return self._worked_out()[1]
 
     @property
     def point(self) -> np.ndarray | None:
-        return self._unit_twist_and_axis()[2]
+        return self._worked_out()[2]
 
     @property
     def pitch(self) -> float:
-        return self._unit_twist_and_axis()[3]
+        return self._worked_out()[3]
 
-    def _unit_twist_and_axis(self) -> tuple:
+    def _worked_out(self) -> tuple:
         """``(twist, direction, point, pitch)``, worked out once."""
         if self._axis is None:
             self._axis = _unit_twist_and_axis(self._given, self.length_scale)
