@@ -9,7 +9,6 @@ import pytest
 
 from fixplan import LimitSurface, pressure
 from fixplan.models.exact import Exact
-from fixplan.planner.osculating import _support
 
 FIELDS = {
     "uniform disk": pressure.disk(0.01),
@@ -77,18 +76,6 @@ def test_the_support_hessian_is_the_derivative_of_the_load(name):
             < 1e-6 * np.abs(expected * np.outer(scale, scale)).max()
         )
         np.testing.assert_allclose(hessian @ twist, 0.0, atol=1e-9 * np.abs(hessian).max())
-
-
-def test_the_ellipsoids_support_is_the_norm_of_the_inverse_transpose_factor_times_the_twist():
-    # Upper triangular R (the planner's ellipsoids): ‖R⁻ᵀ V‖ against a dense linear solve.
-    rng = np.random.default_rng(7)
-    factors = np.triu(rng.normal(size=(50, 3, 3)))
-    factors[:, [0, 1, 2], [0, 1, 2]] = rng.uniform(0.5, 2.0, size=(50, 3))
-    twists = rng.normal(size=(50, 3))
-    expected = np.linalg.norm(
-        np.linalg.solve(factors.transpose(0, 2, 1), twists[:, :, None]), axis=1
-    )
-    np.testing.assert_allclose(_support(factors, twists), expected[:, 0], rtol=1e-12)
 
 
 @pytest.mark.parametrize("name", FIELDS)

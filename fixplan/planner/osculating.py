@@ -40,6 +40,7 @@ import numpy as np
 
 from fixplan.models.exact import Exact
 from fixplan.planner.exact_contacts import ExactContacts
+from fixplan.planner.osculating_steps import SETTLE, SOLVED_PAIRS
 from fixplan.planner.parameters import assign
 from fixplan.tolerances import (
     CAP_RTOL,
@@ -171,6 +172,14 @@ class OsculatingPool(ExactContacts):
         self._next_slot = np.zeros((count, cases), dtype=int)
         #: ``(E, K)`` the excess of each pair's load in the last round of this solve (NaN: none).
         self._previous_excess = np.full((count, cases), np.nan)
+        #: Buffers of a round's pairs (:func:`~fixplan.planner.osculating_steps.solved_pairs`).
+        pairs = count * cases
+        self._pairs = (
+            np.empty(pairs, dtype=np.int64), np.empty(pairs, dtype=np.int64),
+            np.empty((pairs, 3)), np.empty((pairs, 3)),
+            np.empty(pairs, dtype=np.int64), np.empty(pairs, dtype=np.int64),
+            np.empty((pairs, 3)), np.empty(pairs),
+        )  # fmt: skip
         #: The ellipsoids and cut planes of the last solve (before :meth:`move` moved them).
         self._solved_with = (self._factors.copy(), self._planes.copy())
         self._entries = [(r, c) for r in range(3) for c in range(r, 3)]  # upper triangle
@@ -224,79 +233,50 @@ class OsculatingPool(ExactContacts):
         self._solved_with = (self._factors.copy(), self._planes.copy())
         normal = self._normal_values()
         friction = np.asarray(self._friction.value, dtype=float)
-        forces = normal[self._contacts]  # (E, K)
-        loads = friction[self._rows].transpose(1, 0, 2)  # (3, E, K)
         twists = self._twists() * self._units[:, None, :]  # (E, K, 3), normalised
-        sizes = np.linalg.norm(twists, axis=2)
+        sizes = np.sqrt(np.einsum("ekc,ekc->ek", twists, twists))
         weights = self._weights(sizes)
         # Twists below the floor count as none in the tests of a settled round, but still
         # steer stalled loads (``slow``): counted as none there too, the fixture of
         # benchmarks/bench_exact.py took 4.30 rounds per re-solve instead of 4.04.
         counted = weights if self._scale is not None else weights * (sizes >= FORCE_DUAL_FLOOR)
         noise = FRICTION_SET_RTOL * max(float(np.abs(normal).max(initial=0.0)), 1e-300)
-        pressed = forces > noise
-        per_unit = np.where(pressed, loads, 0.0) / np.where(pressed, forces, 1.0)  # (3, E, K)
-        moving = pressed & (np.abs(per_unit).max(axis=0) > 0.0)
+        pairs = self._pairs
+        moving, idle = SOLVED_PAIRS(
+            normal[self._contacts], friction, self._rows, noise, self._factors, twists,
+            self._units, counted, *pairs,
+        )  # fmt: skip
+        owner, cases, per_unit, used = (array[:moving] for array in pairs[:4])
         self.use[:] = np.nan
-        settled = self._reach(twists, counted, ~pressed)
-        if not moving.any():
+        settled = self._reach(*(array[:idle] for array in pairs[4:]), counted)
+        if moving == 0:
             self._assign()
             return settled
-        owner, cases = np.nonzero(moving)  # contact by contact
-        per_unit = per_unit[:, owner, cases].T
-        # The normals of the ellipsoids the solve used, at its loads: the exact sliding twists
-        # near the optimum (stationarity), where the inverse map starts.
-        used = _normals(self._factors[owner, cases], per_unit)
-        excess, points = np.empty(owner.size), np.empty((owner.size, 3))
-        factors = np.empty((owner.size, 3, 3))
+        # The normals of the ellipsoids the solve used, at its loads (``used``): the exact
+        # sliding twists near the optimum (stationarity), where the inverse map starts.
+        excess, points = np.empty(moving), np.empty((moving, 3))
+        found = np.empty((moving, 3, 3))
         for model, rows in self._by_model(owner):
-            excess[rows], points[rows], factors[rows] = model.osculating(per_unit[rows], used[rows])
-        self.use[self._contacts[owner], cases] = 1.0 + excess
-        exact_normals = _normals(factors, points)
-        limiting = counted[owner, cases] > 0.0  # (a NaN normal elsewhere does not matter)
-        weight = counted[owner, cases][limiting]
-        gap = weight * _chord(used[limiting], exact_normals[limiting])
-        settled &= bool(
-            np.all(excess <= EXACT_CUT_RTOL)
-            and np.all(gap <= STATIONARITY_RTOL)
-            and np.all(weight * np.maximum(-excess[limiting], 0.0) <= COMPLEMENTARITY_RTOL)
-        )
-        beyond = excess > EXACT_CUT_RTOL
-        previous = self._previous_excess[owner, cases]
-        self._previous_excess[:] = np.nan
-        self._previous_excess[owner, cases] = excess
-        stalled = beyond & (excess >= PROGRESS * previous)
-        slow = stalled & (weights[owner, cases] > 0.0)
-        moved = self._anchored(factors, twists, owner, cases, slow)
-        usable = np.all(np.isfinite(moved), axis=(1, 2))
-        self._factors[owner[usable], cases[usable]] = moved[usable] * (1.0 + MARGIN)
-        outside = np.flatnonzero(np.all(np.isfinite(factors), axis=(1, 2)) & beyond)
-        if outside.size:
-            e, k = owner[outside], cases[outside]
-            normals = exact_normals[outside]
-            planes = normals / np.einsum("kc,kc->k", normals, points[outside])[:, None]
-            slots = self._next_slot[e, k]
-            scale = np.where(stalled[outside], 1.0 + MARGIN, 1.0 / (1.0 + CUT_SLACK))
-            self._planes[:, slots, e, k] = planes.T * scale
-            self._next_slot[e, k] = (slots + 1) % CUT_SLOTS
-        self._assign()
-        return settled
+            excess[rows], points[rows], found[rows] = model.osculating(per_unit[rows], used[rows])
+        slow = np.empty(moving, dtype=bool)
+        solved, cut = SETTLE(
+            owner, cases, excess, points, found, used, counted, weights, self._contacts,
+            self.use, self._previous_excess, self._factors, self._planes, self._next_slot, slow,
+            EXACT_CUT_RTOL, STATIONARITY_RTOL, COMPLEMENTARITY_RTOL, PROGRESS, MARGIN, CUT_SLACK,
+        )  # fmt: skip
+        if slow.any():
+            self._anchor(twists, owner[slow], cases[slow])
+        self._assign(cuts=cut)
+        return settled and solved
 
-    def _anchored(self, factors, twists, owner, cases, slow) -> np.ndarray:
-        """``factors`` ``(P, 3, 3)`` of the pairs ``(owner, cases)``, those of the ``slow`` pairs
-        replaced by the ellipsoids that osculate where the exact set's normal is the pair's
-        twist in the solve (see ``PROGRESS``), where those are finite."""
-        if not slow.any():
-            return factors
-        factors = factors.copy()
-        chosen = np.flatnonzero(slow)
-        for model, part in self._by_model(owner[chosen]):
-            rows = chosen[part]
-            load_twists = twists[owner[rows], cases[rows]] / self._units[owner[rows]]
-            found = model.osculating_at(load_twists)[1]
+    def _anchor(self, twists: np.ndarray, owner: np.ndarray, cases: np.ndarray) -> None:
+        """Move the ellipsoids of the pairs ``(owner, cases)`` to osculate where the exact set's
+        normal is the pair's twist in the solve (see ``PROGRESS``), where those are finite."""
+        for model, rows in self._by_model(owner):
+            e, k = owner[rows], cases[rows]
+            found = model.osculating_at(twists[e, k] / self._units[e])[1]
             finite = np.all(np.isfinite(found), axis=(1, 2))
-            factors[rows[finite]] = found[finite]
-        return factors
+            self._factors[e[finite], k[finite]] = found[finite] * (1.0 + MARGIN)
 
     def _weights(self, sizes: np.ndarray) -> np.ndarray:
         """``(E, K)`` twist sizes relative to the largest (per case for fixed-force objectives,
@@ -310,20 +290,18 @@ class OsculatingPool(ExactContacts):
         ] = 0
         return weights
 
-    def _reach(self, twists: np.ndarray, weights: np.ndarray, idle: np.ndarray) -> bool:
-        """Whether the ellipsoids of the ``idle`` (unpressed) contacts reach as far as their
-        exact sets in the directions of their ``twists`` (``SUPPORT_RTOL``); those that fall
-        short are moved to osculate at the exact point with that normal."""
-        owner, cases = np.nonzero(idle & (weights > 0.0))
+    def _reach(self, owner, cases, twists, reach, weights) -> bool:
+        """Whether the ellipsoids of the unpressed pairs ``(owner, cases)`` of weight above 0
+        reach as far as their exact sets in the directions of their load-space ``twists``
+        (``SUPPORT_RTOL``; ``reach`` the ellipsoids' supports there); those that fall short
+        are moved to osculate at the exact point with that normal."""
         if owner.size == 0:
             return True
         loose = np.zeros(owner.size, dtype=bool)
         for model, rows in self._by_model(owner):
-            e, k = owner[rows], cases[rows]
-            twist = twists[e, k] / self._units[e]  # load-space twists
-            reach = _support(self._factors[e, k], twist)
-            exact = model.surface.support(twist) / model.surface.normal_force
-            loose[rows] = weights[e, k] * (1.0 - reach / exact) > SUPPORT_RTOL
+            e, k, twist = owner[rows], cases[rows], twists[rows]
+            exact = model.surface._trusted_support(twist) / model.surface.normal_force
+            loose[rows] = weights[e, k] * (1.0 - reach[rows] / exact) > SUPPORT_RTOL
             if loose[rows].any():
                 short = rows[loose[rows]]
                 points = model.surface.load(twist[loose[rows]]) / model.surface.normal_force
@@ -333,31 +311,9 @@ class OsculatingPool(ExactContacts):
                 self._factors[owner[usable], cases[usable]] = found[finite] * (1.0 + MARGIN)
         return not loose.any()
 
-    def _assign(self) -> None:
+    def _assign(self, cuts: bool = True) -> None:
+        """Set the ellipsoids' Parameters (and the cuts', with ``cuts``)."""
         for (r, c), parameter in zip(self._entries, self._parameters, strict=True):
             assign(parameter, self._factors[:, :, r, c])
-        self._assign_cuts()
-
-
-def _support(factors: np.ndarray, twists: np.ndarray) -> np.ndarray:
-    """Support ``‖R⁻ᵀ V‖`` ``(K,)`` of the ellipsoids ``‖R q‖ <= 1`` (``factors`` ``(K, 3, 3)``
-    upper triangular) at the twists ``V`` ``(K, 3)``: ``Rᵀ y = V`` by forward substitution."""
-    r, v = factors, twists
-    y0 = v[:, 0] / r[:, 0, 0]
-    y1 = (v[:, 1] - r[:, 0, 1] * y0) / r[:, 1, 1]
-    y2 = (v[:, 2] - r[:, 0, 2] * y0 - r[:, 1, 2] * y1) / r[:, 2, 2]
-    return np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
-
-
-def _normals(factors: np.ndarray, loads: np.ndarray) -> np.ndarray:
-    """Outward normals ``RᵀR q`` ``(K, 3)`` of the ellipsoids ``‖R q‖ <= 1`` at the loads'
-    rays (twists, up to their sizes). (In two products: one einsum of the three operands took
-    5.7× as long on the 157 pairs of a fixture round.)"""
-    return np.einsum("krc,kr->kc", factors, np.einsum("krd,kd->kr", factors, loads))
-
-
-def _chord(first: np.ndarray, second: np.ndarray) -> np.ndarray:
-    """Distance between the unit directions of the rows of ``first`` and ``second`` ``(K, 3)``
-    (NaN where one is not finite)."""
-    first = first / np.linalg.norm(first, axis=1, keepdims=True)
-    return np.linalg.norm(first - second / np.linalg.norm(second, axis=1, keepdims=True), axis=1)
+        if cuts:
+            self._assign_cuts()

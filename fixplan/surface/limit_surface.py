@@ -227,13 +227,18 @@ class LimitSurface:
         """Support function ``h(V)`` [W per unit speed] of twists ``(3,)`` or ``(K, 3)`` (0 at
         a zero twist)."""
         twists, single = validation.vector_batch("twist", twist, width=3)
-        if self._compiled is not None and len(twists) <= COMPILED_SUPPORT_MAX_TWISTS:
-            values = self._scale * self._compiled.supports(twists)
-        else:
-            with np.errstate(invalid="ignore", divide="ignore"):  # (the disk kernels at 0)
-                values = self._scale * self._kernel.support(twists)
-            values[~np.any(twists != 0.0, axis=1)] = 0.0
+        values = self._trusted_support(twists)
         return float(values[0]) if single else values
+
+    def _trusted_support(self, twists: np.ndarray) -> np.ndarray:
+        """:meth:`support` ``(K,)`` of finite twists ``(K, 3)`` from a caller that checked them
+        (the planner's exact models, every round; see :meth:`_trusted_inverse`)."""
+        if self._compiled is not None and len(twists) <= COMPILED_SUPPORT_MAX_TWISTS:
+            return self._scale * self._compiled.supports(twists)
+        with np.errstate(invalid="ignore", divide="ignore"):  # (the disk kernels at 0)
+            values = self._scale * self._kernel.support(twists)
+        values[~np.any(twists != 0.0, axis=1)] = 0.0
+        return values
 
     def support_hessian(self, twist) -> np.ndarray:
         """Hessian ``∇²h`` ``(3, 3)`` or ``(K, 3, 3)`` of the support function at nonzero twists:

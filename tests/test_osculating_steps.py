@@ -1,0 +1,188 @@
+"""The compiled steps of a round of osculating ellipsoids (:mod:`fixplan.planner.osculating_steps`)
+against dense NumPy formulas: the pairs listed, their loads, the ellipsoids' normals and
+supports, and the settle tests, ellipsoids and cuts of the rules in
+:mod:`fixplan.planner.osculating`."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fixplan.planner.osculating_steps import SETTLE, SOLVED_PAIRS
+
+#: Tolerances passed to ``settle`` (the module's, by name).
+RULES = {
+    "exact_rtol": 1e-9,
+    "stationarity_rtol": 1e-6,
+    "complementarity_rtol": 1e-6,
+    "progress": 0.1,
+    "margin": 1e-8,
+    "cut_slack": 2e-2,
+}
+
+
+def upper_factors(rng, shape) -> np.ndarray:
+    """Random upper triangular ``R`` ``(*shape, 3, 3)`` with positive diagonals."""
+    factors = np.triu(rng.normal(size=(*shape, 3, 3)))
+    factors[..., [0, 1, 2], [0, 1, 2]] = rng.uniform(0.5, 2.0, size=(*shape, 3))
+    return factors
+
+
+def solved_pairs(forces, friction, rows, noise, factors, twists, units, counted):
+    """``SOLVED_PAIRS`` with fresh buffers: the moving pairs' arrays, then the idle ones'."""
+    pairs = forces.size
+    buffers = (
+        np.empty(pairs, dtype=np.int64), np.empty(pairs, dtype=np.int64),
+        np.empty((pairs, 3)), np.empty((pairs, 3)),
+        np.empty(pairs, dtype=np.int64), np.empty(pairs, dtype=np.int64),
+        np.empty((pairs, 3)), np.empty(pairs),
+    )  # fmt: skip
+    moving, idle = SOLVED_PAIRS(forces, friction, rows, noise, factors, twists, units, counted,
+                                *buffers)  # fmt: skip
+    return [b[:moving] for b in buffers[:4]], [b[:idle] for b in buffers[4:]]
+
+
+def test_the_pairs_of_a_solve_are_its_pressed_loads_and_its_unpressed_moving_contacts():
+    rng = np.random.default_rng(3)
+    contacts, cases = 5, 4
+    forces = rng.uniform(1.0, 10.0, size=(contacts, cases))
+    forces[1, 2] = 1e-9  # below the noise: unpressed
+    forces[3, :] = 0.0
+    rows = rng.permutation(3 * contacts + 2)[: 3 * contacts].reshape(contacts, 3)
+    friction = rng.normal(size=(3 * contacts + 2, cases))
+    friction[rows[0], 1] = 0.0  # pressed without load: not queried
+    factors = upper_factors(rng, (contacts, cases))
+    twists = rng.normal(size=(contacts, cases, 3))
+    units = rng.uniform(0.5, 2.0, size=(contacts, 3))
+    counted = rng.uniform(0.1, 1.0, size=(contacts, cases))
+    counted[3, 0] = 0.0  # unpressed but not in the motion: not tested
+    (owner, case, per_unit, used), (idle_owner, idle_case, idle_twists, reach) = solved_pairs(
+        forces, friction, rows, 1e-6, factors, twists, units, counted
+    )
+
+    pressed = forces > 1e-6
+    with np.errstate(divide="ignore", invalid="ignore"):  # (the unpressed pairs)
+        loads = friction[rows].transpose(0, 2, 1) / forces[:, :, None]  # (E, K, 3)
+    moving = pressed & np.any(loads != 0.0, axis=2)
+    np.testing.assert_array_equal(np.stack([owner, case]), np.nonzero(moving))
+    np.testing.assert_allclose(per_unit, loads[owner, case], rtol=1e-15)
+    r = factors[owner, case]
+    expected = np.einsum("prc,pr->pc", r, np.einsum("prd,pd->pr", r, per_unit))
+    np.testing.assert_allclose(used, expected, rtol=1e-13, atol=1e-13 * np.abs(expected).max())
+
+    np.testing.assert_array_equal(
+        np.stack([idle_owner, idle_case]), np.nonzero(~pressed & (counted > 0))
+    )
+    load_space = twists[idle_owner, idle_case] / units[idle_owner]
+    np.testing.assert_allclose(idle_twists, load_space, rtol=1e-15)
+    transposed = factors[idle_owner, idle_case].transpose(0, 2, 1)
+    support = np.linalg.norm(np.linalg.solve(transposed, load_space[:, :, None])[:, :, 0], axis=1)
+    np.testing.assert_allclose(reach, support, rtol=1e-12)
+
+
+class Round:
+    """One round's state for ``SETTLE``: ``pairs`` pairs of one contact each, in one case."""
+
+    def __init__(self, rng, pairs: int, slots: int = 2):
+        self.owner = np.arange(pairs, dtype=np.int64)
+        self.cases = np.zeros(pairs, dtype=np.int64)
+        self.found = upper_factors(rng, (pairs,))
+        directions = rng.normal(size=(pairs, 3))
+        # Points on each found ellipsoid ‖R u‖ = 1, and the solve's normals there.
+        self.points = directions / np.linalg.norm(np.einsum("prc,pc->pr", self.found, directions),
+                                                  axis=1)[:, None]  # fmt: skip
+        self.normals = np.einsum(
+            "prc,pr->pc", self.found, np.einsum("prd,pd->pr", self.found, self.points)
+        )
+        self.used = self.normals.copy()
+        self.excess = np.full(pairs, -5e-9)
+        self.counted = np.ones((pairs, 1))
+        self.weights = np.ones((pairs, 1))
+        self.contacts = np.arange(pairs, dtype=np.int64) + 1
+        self.use = np.full((pairs + 1, 1), np.nan)
+        self.previous = np.full((pairs, 1), np.nan)
+        self.factors = np.zeros((pairs, 1, 3, 3))
+        self.planes = np.zeros((3, slots, pairs, 1))
+        self.next_slot = np.zeros((pairs, 1), dtype=np.int64)
+        self.slow = np.zeros(pairs, dtype=bool)
+
+    def settle(self) -> tuple[bool, bool]:
+        return SETTLE(
+            self.owner, self.cases, self.excess, self.points, self.found, self.used, self.counted,
+            self.weights, self.contacts, self.use, self.previous, self.factors, self.planes,
+            self.next_slot, self.slow, *RULES.values(),
+        )  # fmt: skip
+
+
+def test_a_round_whose_loads_are_on_their_exact_sets_with_the_exact_normals_settles():
+    state = Round(np.random.default_rng(5), 4)
+    assert state.settle() == (True, False)
+    np.testing.assert_array_equal(state.use[1:, 0], 1.0 + state.excess)
+    assert np.isnan(state.use[0, 0])
+    np.testing.assert_array_equal(state.previous[:, 0], state.excess)
+    np.testing.assert_allclose(state.factors[:, 0], state.found * (1.0 + RULES["margin"]),
+                               rtol=1e-15)  # fmt: skip
+    assert not state.planes.any() and not state.slow.any()
+
+
+@pytest.mark.parametrize(
+    "change",
+    [
+        "outside",  # a load beyond its exact set
+        "normal",  # a limiting load where the solve's normal is not the exact one
+        "inside",  # a limiting load left inside its set
+    ],
+)
+def test_a_round_that_misses_one_optimality_condition_does_not_settle(change):
+    state = Round(np.random.default_rng(6), 3)
+    if change == "outside":
+        state.excess[1] = 2e-9
+    elif change == "normal":
+        state.used[1] += 2e-6 * np.linalg.norm(state.used[1]) * np.array([1.0, -1.0, 0.5])
+    else:
+        state.excess[1] = -2e-6
+    assert state.settle()[0] is False
+    # Where the contact does not limit the optimum (weight 0), only being inside counts.
+    state = Round(np.random.default_rng(6), 3)
+    state.counted[1] = 0.0
+    if change == "outside":
+        state.excess[1] = 2e-9
+    elif change == "normal":
+        state.used[1] = -state.used[1]
+    else:
+        state.excess[1] = -0.5
+    assert state.settle()[0] is (change != "outside")
+
+
+def test_a_load_outside_gets_the_tangent_plane_of_its_ray_moved_out_unless_it_stalled():
+    state = Round(np.random.default_rng(8), 3)
+    state.excess[:] = [0.3, 0.3, -5e-9]
+    state.previous[:, 0] = [5.0, 0.5, np.nan]  # the first fell by more than 10x, the second not
+    state.weights[1] = 0.0
+    assert state.settle() == (False, True)
+    # The plane a·ℓ <= 1 through the point with the exact set's normal there.
+    plane = state.normals / np.einsum("pc,pc->p", state.normals, state.points)[:, None]
+    np.testing.assert_allclose(state.planes[:, 0, 0, 0], plane[0] / (1 + RULES["cut_slack"]),
+                               rtol=1e-13)  # fmt: skip
+    np.testing.assert_allclose(state.planes[:, 0, 1, 0], plane[1] * (1 + RULES["margin"]),
+                               rtol=1e-13)  # fmt: skip
+    assert not state.planes[:, :, 2].any() and not state.planes[:, 1].any()
+    np.testing.assert_array_equal(state.next_slot[:, 0], [1, 1, 0])
+    # Stalled pairs are slow where they take part in the motion (weight above 0).
+    np.testing.assert_array_equal(state.slow, [False, False, False])
+    state.weights[1] = 1.0
+    state.previous[:, 0] = [5.0, 0.5, np.nan]
+    assert state.settle() == (False, True)
+    np.testing.assert_array_equal(state.slow, [False, True, False])
+    np.testing.assert_array_equal(state.next_slot[:, 0], [0, 0, 0])  # the slots went round
+    assert state.planes[:, 1, :2].all()
+
+
+def test_an_ellipsoid_that_is_not_finite_is_neither_placed_nor_cut():
+    state = Round(np.random.default_rng(9), 2)
+    state.found[0, 2, 2] = np.nan  # no curvature there (a facet)
+    state.excess[0] = 0.1
+    assert state.settle() == (False, False)
+    assert not state.factors[0].any()
+    np.testing.assert_allclose(state.factors[1, 0], state.found[1] * (1 + RULES["margin"]))
+    assert not state.planes.any()
