@@ -297,19 +297,20 @@ class OsculatingPool(ExactContacts):
         are moved to osculate at the exact point with that normal."""
         if owner.size == 0:
             return True
-        loose = np.zeros(owner.size, dtype=bool)
+        exact = np.empty(owner.size)
         for model, rows in self._by_model(owner):
-            e, k, twist = owner[rows], cases[rows], twists[rows]
-            exact = model.surface._trusted_support(twist) / model.surface.normal_force
-            loose[rows] = weights[e, k] * (1.0 - reach[rows] / exact) > SUPPORT_RTOL
-            if loose[rows].any():
-                short = rows[loose[rows]]
-                points = model.surface.load(twist[loose[rows]]) / model.surface.normal_force
-                found = model.osculating(points)[2]
-                finite = np.all(np.isfinite(found), axis=(1, 2))
-                usable = short[finite]
-                self._factors[owner[usable], cases[usable]] = found[finite] * (1.0 + MARGIN)
-        return not loose.any()
+            surface = model.surface
+            exact[rows] = surface._trusted_support(twists[rows]) / surface.normal_force
+        loose = weights[owner, cases] * (1.0 - reach / exact) > SUPPORT_RTOL
+        if not loose.any():
+            return True
+        short = np.flatnonzero(loose)
+        for model, rows in self._by_model(owner[short]):
+            e, k = owner[short[rows]], cases[short[rows]]
+            found = model.osculating_at(twists[short[rows]])[1]
+            finite = np.all(np.isfinite(found), axis=(1, 2))
+            self._factors[e[finite], k[finite]] = found[finite] * (1.0 + MARGIN)
+        return False
 
     def _assign(self, cuts: bool = True) -> None:
         """Set the ellipsoids' Parameters (and the cuts', with ``cuts``)."""
