@@ -4,7 +4,7 @@
 A round reads the solve's loads and twists, lists the pairs (exact contact, load case) whose
 loads the exact models are asked about, and after those queries tests whether the solve met the
 exact problem's optimality conditions and moves the ellipsoids and cuts. As some forty NumPy
-steps on the few pairs of a grasp, that took more time than the queries and the solve together;
+steps on the few pairs of a grasp, that took as much time as the queries and the solve together;
 here it is two compiled passes over the pairs. The rules and tolerances are those of
 :mod:`fixplan.planner.osculating`, which passes them in.
 """
