@@ -16,12 +16,14 @@ when the solve meets the optimality conditions of the exact problem. Every conta
 inside its exact set (to ``EXACT_CUT_RTOL``); where a contact limits the optimum (its twist in
 the impending motion, the equilibrium's multipliers mapped to the contact, ``V_ij = -G_iᵀ y_j``,
 is not zero), the solve made that twist the normal of the ellipsoid it used at the load, so
-that ellipsoid's normal there must be the exact set's (``STATIONARITY_RTOL``; the normals are
-compared rather than the twist, whose direction an interior-point solve gives to about 1e-5)
-and the load must lie on the exact surface (``COMPLEMENTARITY_RTOL``), each weighed by the
-twist's size relative to the largest (of the load case, for the fixed-force objectives, whose cases are
-independent). Loads of contacts that do not limit the optimum may be anywhere inside (an
-optimum's loads are often not unique). A fixed-force case whose multiple sits at a bound (0, or
+that ellipsoid's normal there must be the exact set's (``STATIONARITY_RTOL``, weighed by the
+twist's size relative to the largest, of the load case for the fixed-force objectives, whose
+cases are independent; the normals are compared rather than the twist, whose direction an
+interior-point solve gives to about 1e-5) and the load must lie on the exact surface: what
+limiting loads left inside their sets cost the objective, to first order their powers ``P =
+L·V`` times the fractions they are inside, at most ``COMPLEMENTARITY_RTOL`` of it. Loads of
+contacts that do not limit the optimum may be anywhere inside (an optimum's loads are often not
+unique). A fixed-force case whose multiple sits at a bound (0, or
 the cap) needs no stationarity: its exactly feasible loads prove that multiple optimal. A
 contact without load (not pressed) that takes part in the impending motion is held at no normal
 force because its set looks too small in the direction of its twist ``V``: its ellipsoid must
@@ -58,21 +60,21 @@ MAX_ROUNDS = 12
 #: impending motion relative to the largest.
 STATIONARITY_RTOL = 1e-6
 
-#: Largest relative gap ``1 - 1/s`` of a load inside its exact set, times the size of its
-#: contact's twist relative to the largest. A limiting load left inside costs the objective
-#: about this fraction (first order, where a normal's error costs its square), but
-#: interior-point solves leave limiting loads inside by their own tolerance: about ``1e-8 /
-#: weight`` each, a few 1e-7 where they limit weakly. At 1e-5, a re-solve of a pinch of the
-#: random problems of tests/test_osculating_agreement.py settled with a load 1.7e-5 inside
-#: (weight 0.21) and clamp forces 3.9e-6 above the optimum; at 1e-6, over 900 plans of 180 such
-#: problems (pinches and plates, solved and re-solved with new loads), 6 were 1.1e-7 to 4.0e-7
-#: off the cutting planes' optimum (either way: both end in interior-point solves) and none
-#: more, with the same rounds on the fixture of benchmarks/bench_exact.py (4.04 per re-solve).
-#: At 1e-7 the fixed-force fixtures of tests/test_exact_planner.py did not settle in
-#: ``MAX_ROUNDS``, and 5 of the 10,000 steps of benchmarks/bench_realtime.py's path went to the
-#: cutting planes (1 at 1e-6). An ellipsoid whose normal agrees with the exact one
-#: (``STATIONARITY_RTOL``) but that holds a load back leaves far more.
-COMPLEMENTARITY_RTOL = 1e-6
+#: Largest first-order cost to the objective, relative to it (at least 1 in the program's units:
+#: newtons over the block's force unit, or load multiples), of the limiting loads a solve left
+#: inside their exact sets: ``Σ P_i max(1 - 1/s_i - MARGIN, 0)``, where ``P_i = L_i·V_i`` is the
+#: power of contact load ``L_i`` in its twist (the multiplier of its set: the objective's
+#: derivative in the set's size) and the ``MARGIN`` the ellipsoids are tightened by is not
+#: counted. Interior-point solves leave about 1e-8 of the objective so (their duality gap).
+#: Weighed instead by the twists' sizes relative to the largest (``STATIONARITY_RTOL``'s
+#: weights) and held to 1e-6 per load, a re-solve of a random pinch settled 7.6e-7 above the
+#: cutting planes' optimum, and on the path of benchmarks/bench_realtime.py a safety analysis
+#: settled with a support pad's load 5.8e-5 inside (twist weight 0.015, but 17 % of the power):
+#: ``k_max`` 4.3e-5 low; at 1e-7 so, the fixed-force fixtures of tests/test_exact_planner.py
+#: did not settle in ``MAX_ROUNDS`` and 5 of the path's 10,000 steps went to the cutting planes.
+#: Now none does (1.70 rounds per step with the analysis, 1.23 bare), and the fixture of
+#: benchmarks/bench_exact.py takes 4.33 rounds per re-solve against 4.15.
+COMPLEMENTARITY_RTOL = 1e-7
 
 #: Largest relative shortfall ``1 - h_E(V) / h_1(V)`` of the support of an unpressed contact's
 #: ellipsoid below the exact set's in the direction of its twist ``V``, times the twist's size
@@ -172,11 +174,13 @@ class OsculatingPool(ExactContacts):
         self._next_slot = np.zeros((count, cases), dtype=int)
         #: ``(E, K)`` the excess of each pair's load in the last round of this solve (NaN: none).
         self._previous_excess = np.full((count, cases), np.nan)
+        #: The objective value of the last solve (set by :meth:`converge`).
+        self._objective: Callable[[], float] = lambda: float("nan")
         #: Buffers of a round's pairs (:func:`~fixplan.planner.osculating_steps.solved_pairs`).
         pairs = count * cases
         self._pairs = (
             np.empty(pairs, dtype=np.int64), np.empty(pairs, dtype=np.int64),
-            np.empty((pairs, 3)), np.empty((pairs, 3)),
+            np.empty((pairs, 3)), np.empty((pairs, 3)), np.empty(pairs),
             np.empty(pairs, dtype=np.int64), np.empty(pairs, dtype=np.int64),
             np.empty((pairs, 3)), np.empty(pairs),
         )  # fmt: skip
@@ -214,10 +218,14 @@ class OsculatingPool(ExactContacts):
         self._factors[:], self._planes[:] = factors, planes
         self._assign()
 
-    def converge(self, solve: Callable[[], str], status: str) -> tuple[str, bool]:
+    def converge(
+        self, solve: Callable[[], str], status: str, objective: Callable[[], float]
+    ) -> tuple[str, bool]:
         """Move the ellipsoids and re-solve (``solve()`` returns the status) from a first
         solve's ``status``; the final status and whether the rounds settled on the exact
-        optimum (otherwise the cutting planes take over)."""
+        optimum (otherwise the cutting planes take over). ``objective()`` is the last solve's
+        objective value (in the program's units)."""
+        self._objective = objective
         self._previous_excess[:] = np.nan
         for _ in range(MAX_ROUNDS):
             if status not in ("optimal", "inaccurate"):
@@ -246,9 +254,9 @@ class OsculatingPool(ExactContacts):
             normal[self._contacts], friction, self._rows, noise, self._factors, twists,
             self._units, counted, *pairs,
         )  # fmt: skip
-        owner, cases, per_unit, used = (array[:moving] for array in pairs[:4])
+        owner, cases, per_unit, used, power = (array[:moving] for array in pairs[:5])
         self.use[:] = np.nan
-        settled = self._reach(*(array[:idle] for array in pairs[4:]), counted)
+        settled = self._reach(*(array[:idle] for array in pairs[5:]), counted)
         if moving == 0:
             self._assign()
             return settled
@@ -259,10 +267,11 @@ class OsculatingPool(ExactContacts):
         for model, rows in self._by_model(owner):
             excess[rows], points[rows], found[rows] = model.osculating(per_unit[rows], used[rows])
         slow = np.empty(moving, dtype=bool)
+        held_back_max = COMPLEMENTARITY_RTOL * max(abs(self._objective()), 1.0)
         solved, cut = SETTLE(
-            owner, cases, excess, points, found, used, counted, weights, self._contacts,
+            owner, cases, excess, points, found, used, power, counted, weights, self._contacts,
             self.use, self._previous_excess, self._factors, self._planes, self._next_slot, slow,
-            EXACT_CUT_RTOL, STATIONARITY_RTOL, COMPLEMENTARITY_RTOL, PROGRESS, MARGIN, CUT_SLACK,
+            EXACT_CUT_RTOL, STATIONARITY_RTOL, held_back_max, PROGRESS, MARGIN, CUT_SLACK,
         )  # fmt: skip
         if slow.any():
             self._anchor(twists, owner[slow], cases[slow])

@@ -18,7 +18,7 @@ from fixplan.surface.point_kernel import compiled_scalar
 
 def solved_pairs(
     forces, friction, rows, noise, factors, twists, units, counted,
-    owner, cases, per_unit, used, idle_owner, idle_cases, idle_twists, idle_reach,
+    owner, cases, per_unit, used, power, idle_owner, idle_cases, idle_twists, idle_reach,
 ):  # fmt: skip  # pragma: no cover - compiled
     """The pairs of a solve to query, in order of contact then case; returns their count and
     that of the unpressed pairs to test (``(moving, idle)``).
@@ -34,9 +34,10 @@ def solved_pairs(
     twists, units, counted : numpy.ndarray
         ``(E, K, 3)`` normalised twists of the solve, ``(E, 3)`` the contacts' units, ``(E, K)``
         the twists' weights in the settle tests.
-    owner, cases, per_unit, used : numpy.ndarray
+    owner, cases, per_unit, used, power : numpy.ndarray
         Out: the pressed pairs with load (contact, case), their loads per unit normal force
-        ``(P, 3)`` and the normals ``RᵀR q`` of their ellipsoids there.
+        ``(P, 3)``, the normals ``RᵀR q`` of their ellipsoids there and the power ``|L · V|``
+        of each load ``L`` [N, N, N m] in its contact's twist ``V`` (load space).
     idle_owner, idle_cases, idle_twists, idle_reach : numpy.ndarray
         Out: the unpressed pairs of weight above 0, their load-space twists ``V`` ``(I, 3)``
         and their ellipsoids' supports ``‖R⁻ᵀ V‖`` there.
@@ -67,30 +68,34 @@ def solved_pairs(
                 owner[moving], cases[moving] = e, k
                 per_unit[moving, 0], per_unit[moving, 1], per_unit[moving, 2] = q0, q1, q2
                 _normal(r, q0, q1, q2, used[moving])
+                power[moving] = force * abs(
+                    q0 * twists[e, k, 0] / units[e, 0]
+                    + q1 * twists[e, k, 1] / units[e, 1]
+                    + q2 * twists[e, k, 2] / units[e, 2]
+                )
                 moving += 1
     return moving, idle
 
 
 def settle(
-    owner, cases, excess, points, found, used, counted, weights, contacts,
+    owner, cases, excess, points, found, used, power, counted, weights, contacts,
     use, previous, factors, planes, next_slot, slow,
-    exact_rtol, stationarity_rtol, complementarity_rtol, progress, margin, cut_slack,
+    exact_rtol, stationarity_rtol, held_back_max, progress, margin, cut_slack,
 ):  # fmt: skip  # pragma: no cover - compiled
     """After the queries of the pairs ``(owner, cases)`` ``(P,)`` (:func:`solved_pairs`): whether
     the solve met the optimality conditions, and whether a cut was placed (``(settled, cut)``).
 
     ``excess`` ``(P,)``, ``points`` ``(P, 3)`` and ``found`` ``(P, 3, 3)`` are the queries'
-    answers (:meth:`~fixplan.models.Exact.osculating`), ``used`` the normals the solve used.
-    Writes the friction use ``1 + excess`` into ``use`` ``(C, K)`` (rows ``contacts``), the
-    excess into ``previous`` ``(E, K)`` (NaN elsewhere; read first: a pair that stalled, its
-    excess not below ``progress`` times the last round's, is marked in ``slow`` where its
-    weight is above 0), the finite ellipsoids found, tightened by ``margin``, into ``factors``
-    ``(E, K, 3, 3)``, and for each load outside its set (and a finite ellipsoid) the exact
-    set's tangent plane at the load's ray into the next of the pair's slots of ``planes``
-    ``(3, S, E, K)``: moved out by ``cut_slack``, or in by ``margin`` where the pair stalled.
+    answers (:meth:`~fixplan.models.Exact.osculating`), ``used`` the normals the solve used and
+    ``power`` the pairs' powers. The optimality conditions: every load inside its exact set
+    (``exact_rtol``); at each pair of weight (``counted``) above 0, the exact set's normal the
+    solve's (``stationarity_rtol``, weighed), and the power that these loads hold back inside
+    their sets beyond the ``margin`` the ellipsoids are tightened by, ``Σ P_i max(-excess_i -
+    margin, 0)``, at most ``held_back_max`` (in the objective's units: its first-order cost).
     """
     count = owner.shape[0]
     settled, cut = True, False
+    held_back = 0.0
     last = np.empty(count)
     for p in range(count):
         last[p] = previous[owner[p], cases[p]]
@@ -106,9 +111,9 @@ def settle(
         if not over <= exact_rtol:
             settled = False
         if weight > 0.0:
-            gap = weight * _chord(used[p], normal)
-            if not (gap <= stationarity_rtol and weight * max(-over, 0.0) <= complementarity_rtol):
+            if not weight * _chord(used[p], normal) <= stationarity_rtol:
                 settled = False
+            held_back += power[p] * max(-over - margin, 0.0)
         beyond = over > exact_rtol
         stalled = beyond and over >= progress * last[p]
         slow[p] = stalled and weights[e, k] > 0.0
@@ -125,6 +130,8 @@ def settle(
                 planes[i, slot, e, k] = normal[i] / offset * scale
             next_slot[e, k] = (slot + 1) % planes.shape[1]
             cut = True
+    if not held_back <= held_back_max:
+        settled = False
     return settled, cut
 
 

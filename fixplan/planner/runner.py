@@ -667,11 +667,16 @@ class Runner:
                 self._prepare_direct(key, stacked)
             return status
 
+        def value() -> float:
+            if self._directly == key:
+                return self._direct[key].objective_value
+            return float(stacked.problem.value)
+
         status = once()
         if stacked.exact is None:
             return status, True
         if isinstance(stacked.exact, OsculatingPool):
-            return stacked.exact.converge(once, status)
+            return stacked.exact.converge(once, status, value)
         status, more = stacked.exact.converge(once, status)
         notes.extend(more)
         return status, True
