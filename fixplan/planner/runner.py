@@ -670,7 +670,8 @@ class Runner:
         def value() -> float:
             if self._directly == key:
                 return self._direct[key].objective_value
-            return float(stacked.problem.value)
+            found = stacked.problem.value
+            return float("nan") if found is None else float(found)  # (NaN: the rounds go on)
 
         status = once()
         if stacked.exact is None:
