@@ -37,7 +37,8 @@ def solved_pairs(
     owner, cases, per_unit, used, power : numpy.ndarray
         Out: the pressed pairs with load (contact, case), their loads per unit normal force
         ``(P, 3)``, the normals ``RᵀR q`` of their ellipsoids there and the power ``|L · V|``
-        of each load ``L`` [N, N, N m] in its contact's twist ``V`` (load space).
+        of each load ``L`` in its contact's twist ``V`` (load space; the program's units: the
+        objective's).
     idle_owner, idle_cases, idle_twists, idle_reach : numpy.ndarray
         Out: the unpressed pairs of weight above 0, their load-space twists ``V`` ``(I, 3)``
         and their ellipsoids' supports ``‖R⁻ᵀ V‖`` there.
