@@ -1,14 +1,21 @@
 """The compiled steps of a round of osculating ellipsoids (:mod:`fixplan.planner.osculating_steps`)
 against dense NumPy formulas: the pairs listed, their loads, the ellipsoids' normals and
 supports, and the settle tests, ellipsoids and cuts of the rules in
-:mod:`fixplan.planner.osculating`."""
+:mod:`fixplan.planner.osculating`; the loads' powers against what growing the friction sets
+does to the optimum."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
+from test_kept_parameters import bench_fixture
 
+from fixplan.planner import osculating
 from fixplan.planner.osculating_steps import SETTLE, SOLVED_PAIRS
+from fixplan.planner.planner import Planner
+from fixplan.planner.problem import Load
 
 #: Tolerances passed to ``settle`` (the module's, by name).
 RULES = {
@@ -222,3 +229,38 @@ def test_the_margin_the_ellipsoids_are_tightened_by_holds_nothing_back():
     assert state.settle()[0] is True
     state.excess[0] = -3e-8  # 2e-8 beyond the margin, at a power of 1e3: 2e-5 held back
     assert state.settle()[0] is False
+
+
+@pytest.mark.parametrize("objective", ["min-total-clamp-force", "check"])
+def test_the_powers_are_what_the_friction_sets_are_worth_to_the_objective(objective, monkeypatch):
+    # The rule above rests on P_i = L_i·V_i being the derivative of the optimum in the size of
+    # contact i's set: friction coefficients all grown by the fraction ε move the optimum by
+    # ε Σ P_i (down for the clamp forces, up for the load multiple). On the fixture of
+    # benchmarks/bench_planner.py (exact models), against two solves.
+    settled = []
+    settle = osculating.SETTLE
+
+    def spy(*args):
+        result = settle(*args)
+        if result[0]:
+            settled.append((args[6].sum(), args[18]))  # (Σ P, held_back_max ∝ the objective)
+        return result
+
+    monkeypatch.setattr(osculating, "SETTLE", spy)
+    cut = [Load(name="cut", force=[80.0, 0.0, -30.0], point=[0.02, 0.01, 0.04], torque=[0, 0, 0])]
+    problem = bench_fixture(cut, "exact")
+    if objective == "check":
+        given = {"clamp-top": 60.0, "clamp-side": 40.0}
+        problem = dataclasses.replace(problem, objective="check", contacts=[
+            dataclasses.replace(c, force=given[c.name]) if c.name in given else c
+            for c in problem.contacts
+        ])  # fmt: skip
+    plan = Planner(problem).solve(analyse=False)
+    power = max(settled, key=lambda found: found[1])[0]  # (check: the largest multiple's solve)
+    epsilon = 1e-4
+    grown = dataclasses.replace(problem, contacts=[
+        dataclasses.replace(c, mu=c.mu * (1 + epsilon)) for c in problem.contacts
+    ])  # fmt: skip
+    change = Planner(grown).solve(analyse=False).objective_value - plan.objective_value
+    sign = -1.0 if objective == "min-total-clamp-force" else 1.0
+    assert change == pytest.approx(sign * epsilon * power, rel=1e-3)
