@@ -21,7 +21,8 @@ from fixplan.planner.problem import Load
 RULES = {
     "exact_rtol": 1e-9,
     "stationarity_rtol": 1e-6,
-    "held_back_max": 1e-7,
+    "held_back_max": np.array([1e-7]),
+    "by_case": False,
     "progress": 0.1,
     "margin": 1e-8,
     "cut_slack": 2e-2,
@@ -44,8 +45,9 @@ def solved_pairs(forces, friction, rows, noise, factors, twists, units, counted)
         np.empty(pairs, dtype=np.int64), np.empty(pairs, dtype=np.int64),
         np.empty((pairs, 3)), np.empty(pairs),
     )  # fmt: skip
-    moving, idle = SOLVED_PAIRS(forces, friction, rows, noise, factors, twists, units, counted,
-                                *buffers)  # fmt: skip
+    moving, idle, finite = SOLVED_PAIRS(forces, friction, rows, noise, factors, twists, units,
+                                        counted, *buffers)  # fmt: skip
+    assert finite
     return [b[:moving] for b in buffers[:5]], [b[:idle] for b in buffers[5:]]
 
 
@@ -121,11 +123,13 @@ class Round:
         self.slow = np.zeros(pairs, dtype=bool)
 
     def settle(self) -> tuple[bool, bool]:
-        return SETTLE(
+        """``SETTLE``'s ``(settled, cut)``; the power held back in :attr:`held_back`."""
+        *found, self.held_back = SETTLE(
             self.owner, self.cases, self.excess, self.points, self.found, self.used, self.power,
             self.counted, self.weights, self.contacts, self.use, self.previous, self.factors,
             self.planes, self.next_slot, self.slow, *self.rules.values(),
         )  # fmt: skip
+        return tuple(found)
 
 
 def test_a_round_whose_loads_are_on_their_exact_sets_with_the_exact_normals_settles():
@@ -212,12 +216,46 @@ def test_the_loads_left_inside_are_weighed_by_the_power_they_hold_back():
     state.counted[:, 0] = [0.26, 0.47, 0.015]
     state.power[:] = [36.6, 45.8, 16.7]
     state.excess[2] = -5.8e-5
-    state.rules["held_back_max"] = 1e-7 * 22.74
+    state.rules["held_back_max"] = np.array([1e-7 * 22.74])
     assert state.settle()[0] is False
+    np.testing.assert_allclose(state.held_back, [16.7 * (5.8e-5 - RULES["margin"])], rtol=1e-12)
     state = Round(np.random.default_rng(10), 3)
     state.power[:] = [1.0, 1.0, 1e-4]
     state.excess[2] = -5e-4  # holds back 5e-8 (the objective 1)
     assert state.settle()[0] is True
+
+
+def test_each_case_of_a_fixed_force_block_is_held_to_its_own_multiple():
+    # A case's loads move only its own multiple: held to 1e-7 of that multiple (at least 1),
+    # not of the block's sum, which a case at the cap (1e3) would make 1e4 times looser.
+    state = Round(np.random.default_rng(12), 2)
+    state.cases[:] = [0, 1]
+    state.counted = np.eye(2)
+    state.weights = np.eye(2)
+    state.use, state.previous = np.full((3, 2), np.nan), np.full((2, 2), np.nan)
+    state.factors, state.planes = np.zeros((2, 2, 3, 3)), np.zeros((3, 2, 2, 2))
+    state.next_slot = np.zeros((2, 2), dtype=np.int64)
+    state.excess[0] = -5e-7  # case 0 (multiple 1): 4.9e-7 held back
+    state.rules.update(held_back_max=1e-7 * np.array([1.0, 1e3]), by_case=True)
+    assert state.settle()[0] is False
+    state.rules.update(held_back_max=np.array([1e-7 * 1001.0]), by_case=False)
+    assert state.settle()[0] is True
+
+
+def test_a_load_that_is_not_finite_keeps_a_round_from_settling():
+    forces = np.ones((2, 1))
+    friction = np.array([[0.1], [np.nan], [0.3], [0.0], [0.0], [0.0]])
+    buffers = (
+        np.empty(2, dtype=np.int64), np.empty(2, dtype=np.int64), np.empty((2, 3)),
+        np.empty((2, 3)), np.empty(2), np.empty(2, dtype=np.int64),
+        np.empty(2, dtype=np.int64), np.empty((2, 3)), np.empty(2),
+    )  # fmt: skip
+    moving, idle, finite = SOLVED_PAIRS(
+        forces, friction, np.arange(6).reshape(2, 3), 1e-6, upper_factors(
+            np.random.default_rng(13), (2, 1)), np.ones((2, 1, 3)), np.ones((2, 3)),
+        np.ones((2, 1)), *buffers,
+    )  # fmt: skip
+    assert (moving, idle, finite) == (0, 0, False)  # (the second contact carries no load)
 
 
 def test_the_margin_the_ellipsoids_are_tightened_by_holds_nothing_back():
@@ -243,7 +281,7 @@ def test_the_powers_are_what_the_friction_sets_are_worth_to_the_objective(object
     def spy(*args):
         result = settle(*args)
         if result[0]:
-            settled.append((args[6].sum(), args[18]))  # (Σ P, held_back_max ∝ the objective)
+            settled.append((args[6].sum(), args[18].max()))  # (Σ P, ∝ the objective)
         return result
 
     monkeypatch.setattr(osculating, "SETTLE", spy)

@@ -61,8 +61,9 @@ MAX_ROUNDS = 12
 STATIONARITY_RTOL = 1e-6
 
 #: Largest first-order cost to the objective, relative to it (at least 1 in the program's units:
-#: newtons over the block's force unit, or load multiples), of the limiting loads a solve left
-#: inside their exact sets: ``Σ P_i max(1 - 1/s_i - MARGIN, 0)``, where ``P_i = L_i·V_i`` is the
+#: newtons over the block's force unit, or load multiples; in a fixed-force block, to each case's
+#: multiple of its own pairs), of the limiting loads a solve left inside their exact sets:
+#: ``Σ P_i max(1 - 1/s_i - MARGIN, 0)``, where ``P_i = L_i·V_i`` is the
 #: power of contact load ``L_i`` in its twist (the multiplier of its set: the objective's
 #: derivative in the set's size) and the ``MARGIN`` the ellipsoids are tightened by is not
 #: counted. Interior-point solves leave about 1e-8 of the objective so (their duality gap).
@@ -174,6 +175,10 @@ class OsculatingPool(ExactContacts):
         self._next_slot = np.zeros((count, cases), dtype=int)
         #: ``(E, K)`` the excess of each pair's load in the last round of this solve (NaN: none).
         self._previous_excess = np.full((count, cases), np.nan)
+        #: What the last round's limiting loads left inside their sets cost the objective,
+        #: to first order (see ``COMPLEMENTARITY_RTOL``): ``(1,)``, or ``(K,)`` by load case for
+        #: the fixed-force objectives.
+        self.held_back = np.zeros(1)
         #: The objective value of the last solve (set by :meth:`converge`).
         self._objective: Callable[[], float] = lambda: float("nan")
         #: Buffers of a round's pairs (:func:`~fixplan.planner.osculating_steps.solved_pairs`).
@@ -250,13 +255,14 @@ class OsculatingPool(ExactContacts):
         counted = weights if self._scale is not None else weights * (sizes >= FORCE_DUAL_FLOOR)
         noise = FRICTION_SET_RTOL * max(float(np.abs(normal).max(initial=0.0)), 1e-300)
         pairs = self._pairs
-        moving, idle = SOLVED_PAIRS(
+        moving, idle, finite = SOLVED_PAIRS(
             normal[self._contacts], friction, self._rows, noise, self._factors, twists,
             self._units, counted, *pairs,
         )  # fmt: skip
         owner, cases, per_unit, used, power = (array[:moving] for array in pairs[:5])
         self.use[:] = np.nan
         settled = self._reach(*(array[:idle] for array in pairs[5:]), counted)
+        settled &= finite and bool(np.all(np.isfinite(weights)))  # (NaN twists weigh nothing)
         if moving == 0:
             self._assign()
             return settled
@@ -267,16 +273,25 @@ class OsculatingPool(ExactContacts):
         for model, rows in self._by_model(owner):
             excess[rows], points[rows], found[rows] = model.osculating(per_unit[rows], used[rows])
         slow = np.empty(moving, dtype=bool)
-        held_back_max = COMPLEMENTARITY_RTOL * max(abs(self._objective()), 1.0)
-        solved, cut = SETTLE(
+        solved, cut, self.held_back = SETTLE(
             owner, cases, excess, points, found, used, power, counted, weights, self._contacts,
             self.use, self._previous_excess, self._factors, self._planes, self._next_slot, slow,
-            EXACT_CUT_RTOL, STATIONARITY_RTOL, held_back_max, PROGRESS, MARGIN, CUT_SLACK,
+            EXACT_CUT_RTOL, STATIONARITY_RTOL, self._held_back_max(), self._scale is not None,
+            PROGRESS, MARGIN, CUT_SLACK,
         )  # fmt: skip
         if slow.any():
             self._anchor(twists, owner[slow], cases[slow])
         self._assign(cuts=cut)
         return settled and solved
+
+    def _held_back_max(self) -> np.ndarray:
+        """What the limiting loads left inside may cost the objective (``COMPLEMENTARITY_RTOL``
+        of it, at least of 1): ``(1,)`` for a force objective, ``(K,)`` for the load multiples
+        of a fixed-force block, each case's against its own (its loads move only it)."""
+        if self._scale is None:
+            return np.array([COMPLEMENTARITY_RTOL * max(abs(self._objective()), 1.0)])
+        multiples = np.abs(np.asarray(self._scale.value, dtype=float))
+        return COMPLEMENTARITY_RTOL * np.maximum(multiples, 1.0)
 
     def _anchor(self, twists: np.ndarray, owner: np.ndarray, cases: np.ndarray) -> None:
         """Move the ellipsoids of the pairs ``(owner, cases)`` to osculate where the exact set's

@@ -20,8 +20,9 @@ def solved_pairs(
     forces, friction, rows, noise, factors, twists, units, counted,
     owner, cases, per_unit, used, power, idle_owner, idle_cases, idle_twists, idle_reach,
 ):  # fmt: skip  # pragma: no cover - compiled
-    """The pairs of a solve to query, in order of contact then case; returns their count and
-    that of the unpressed pairs to test (``(moving, idle)``).
+    """The pairs of a solve to query, in order of contact then case; returns their count, that
+    of the unpressed pairs to test and whether every pressed pair's load is finite (``(moving,
+    idle, finite)``: a round with a load that is not finite cannot settle).
 
     Parameters
     ----------
@@ -43,7 +44,7 @@ def solved_pairs(
         Out: the unpressed pairs of weight above 0, their load-space twists ``V`` ``(I, 3)``
         and their ellipsoids' supports ``‖R⁻ᵀ V‖`` there.
     """
-    moving, idle = 0, 0
+    moving, idle, finite = 0, 0, True
     for e in range(forces.shape[0]):
         for k in range(forces.shape[1]):
             force = forces[e, k]
@@ -65,7 +66,9 @@ def solved_pairs(
             q0 = friction[rows[e, 0], k] / force
             q1 = friction[rows[e, 1], k] / force
             q2 = friction[rows[e, 2], k] / force
-            if max(abs(q0), abs(q1), abs(q2)) > 0.0:
+            if not (np.isfinite(q0) and np.isfinite(q1) and np.isfinite(q2)):
+                finite = False
+            elif q0 != 0.0 or q1 != 0.0 or q2 != 0.0:
                 owner[moving], cases[moving] = e, k
                 per_unit[moving, 0], per_unit[moving, 1], per_unit[moving, 2] = q0, q1, q2
                 _normal(r, q0, q1, q2, used[moving])
@@ -75,16 +78,17 @@ def solved_pairs(
                     + q2 * twists[e, k, 2] / units[e, 2]
                 )
                 moving += 1
-    return moving, idle
+    return moving, idle, finite
 
 
 def settle(
     owner, cases, excess, points, found, used, power, counted, weights, contacts,
     use, previous, factors, planes, next_slot, slow,
-    exact_rtol, stationarity_rtol, held_back_max, progress, margin, cut_slack,
+    exact_rtol, stationarity_rtol, held_back_max, by_case, progress, margin, cut_slack,
 ):  # fmt: skip  # pragma: no cover - compiled
     """After the queries of the pairs ``(owner, cases)`` ``(P,)`` (:func:`solved_pairs`): whether
-    the solve met the optimality conditions, and whether a cut was placed (``(settled, cut)``).
+    the solve met the optimality conditions, whether a cut was placed, and the power held back
+    (``(settled, cut, held_back)``, the last as ``held_back_max``).
 
     ``excess`` ``(P,)``, ``points`` ``(P, 3)`` and ``found`` ``(P, 3, 3)`` are the queries'
     answers (:meth:`~fixplan.models.Exact.osculating`), ``used`` the normals the solve used and
@@ -92,11 +96,13 @@ def settle(
     (``exact_rtol``); at each pair of weight (``counted``) above 0, the exact set's normal the
     solve's (``stationarity_rtol``, weighed), and the power that these loads hold back inside
     their sets beyond the ``margin`` the ellipsoids are tightened by, ``Σ P_i max(-excess_i -
-    margin, 0)``, at most ``held_back_max`` (in the objective's units: its first-order cost).
+    margin, 0)``, at most ``held_back_max`` (in the objective's units: its first-order cost):
+    ``(1,)`` for all pairs, or with ``by_case`` ``(K,)`` for each load case's pairs (the cases
+    of a fixed-force block, each with its own multiple).
     """
     count = owner.shape[0]
     settled, cut = True, False
-    held_back = 0.0
+    held_back = np.zeros(held_back_max.shape[0])
     last = np.empty(count)
     for p in range(count):
         last[p] = previous[owner[p], cases[p]]
@@ -114,7 +120,7 @@ def settle(
         if weight > 0.0:
             if not weight * _chord(used[p], normal) <= stationarity_rtol:
                 settled = False
-            held_back += power[p] * max(-over - margin, 0.0)
+            held_back[k if by_case else 0] += power[p] * max(-over - margin, 0.0)
         beyond = over > exact_rtol
         stalled = beyond and over >= progress * last[p]
         slow[p] = stalled and weights[e, k] > 0.0
@@ -131,9 +137,10 @@ def settle(
                 planes[i, slot, e, k] = normal[i] / offset * scale
             next_slot[e, k] = (slot + 1) % planes.shape[1]
             cut = True
-    if not held_back <= held_back_max:
-        settled = False
-    return settled, cut
+    for group in range(held_back.shape[0]):
+        if not held_back[group] <= held_back_max[group]:
+            settled = False
+    return settled, cut, held_back
 
 
 def _normal(r, q0, q1, q2, out):  # pragma: no cover - compiled

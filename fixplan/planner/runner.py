@@ -31,7 +31,7 @@ from fixplan.planner.answers import SEVERITY, Reader, in_newtons, joined, merge_
 from fixplan.planner.blocks import CASES_PER_BLOCK, block_of, similar_order
 from fixplan.planner.carried import Carried, WithoutLoad
 from fixplan.planner.direct_solve import DirectSolver, same_values
-from fixplan.planner.osculating import OsculatingPool, smooth
+from fixplan.planner.osculating import COMPLEMENTARITY_RTOL, OsculatingPool, smooth
 from fixplan.planner.parameters import assign
 from fixplan.planner.problem import FIXED_FORCE_OBJECTIVES, Problem
 from fixplan.planner.solver_calls import FALLBACK, SOLVER_OPTIONS, call, uses_dpp
@@ -373,10 +373,10 @@ class Runner:
         direct solve: its optimum carried into ``check``'s osculating program, set with the
         ellipsoids and cuts of that solve's last round. Where the pair is optimal there, it is
         at the exact problem's too: the settled loads and twists, which met the exact problem's
-        optimality conditions, are the pair's (the twists scaled by ``α > 0``, and the tests
-        of :mod:`~fixplan.planner.osculating` weigh twists relative to the largest). The point
-        without load has no friction, which every exact set holds. (No ``"solved"``: ``check``
-        is solved in its rounds.)"""
+        optimality conditions, are the pair's (the twists scaled by ``α > 0``; what its limiting
+        loads left inside their sets cost, scaled alike, must be within ``check``'s own
+        ``COMPLEMENTARITY_RTOL``). The point without load has no friction, which every exact
+        set holds. (No ``"solved"``: ``check`` is solved in its rounds.)"""
         (source, unit), key = self._source, ("check", True)
         direct = self._direct.get(key)
         if (
@@ -392,6 +392,10 @@ class Runner:
         if carried is None:
             return {}
         ends = {}
+        # What the force solve's limiting loads left inside their sets cost it, in check's
+        # units (its twists are the force solve's times α, its forces times the units' ratio):
+        # held to check's own COMPLEMENTARITY_RTOL of the multiple 1.
+        held_back = float(self._built[source].exact.held_back.sum()) * unit / check_unit
         for sense in (1.0, -1.0):  # (the other end where the multiple is minimised: α < 0)
             self._set_parameters(key, stacked, wrenches / check_unit, given, sense, None,
                                  disabled, check_unit)  # fmt: skip
@@ -399,6 +403,8 @@ class Runner:
             alpha, worst, _, z = carried.carry(
                 self._direct[source].solution, unit / check_unit, q, values, b
             )
+            if abs(alpha) * held_back > COMPLEMENTARITY_RTOL:
+                worst = np.inf  # (check's own rounds find that end)
             if worst <= CERTIFICATE_RTOL and sense > 0.0:
                 ends["highest"] = {"status": "optimal", "solver": "carried from the force solve",
                                    "warnings": [], "scale": np.array([1.0]),
