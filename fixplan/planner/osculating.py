@@ -21,7 +21,8 @@ twist's size relative to the largest, of the load case for the fixed-force objec
 cases are independent; the normals are compared rather than the twist, whose direction an
 interior-point solve gives to about 1e-5) and the load must lie on the exact surface: what
 limiting loads left inside their sets cost the objective, to first order their powers ``P =
-L·V`` times the fractions they are inside, at most ``COMPLEMENTARITY_RTOL`` of it. Loads of
+L·V`` times the fractions they are inside, at most ``COMPLEMENTARITY_RTOL`` of it (of each
+case's multiple, in a fixed-force block). Loads of
 contacts that do not limit the optimum may be anywhere inside (an optimum's loads are often not
 unique). A fixed-force case whose multiple sits at a bound (0, or
 the cap) needs no stationarity: its exactly feasible loads prove that multiple optimal. A
