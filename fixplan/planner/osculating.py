@@ -265,6 +265,7 @@ class OsculatingPool(ExactContacts):
         settled = self._reach(*(array[:idle] for array in pairs[5:]), counted)
         settled &= finite and bool(np.all(np.isfinite(weights)))  # (NaN twists weigh nothing)
         if moving == 0:
+            self.held_back = np.zeros_like(self.held_back)  # (no load holds anything back)
             self._assign()
             return settled
         # The normals of the ellipsoids the solve used, at its loads (``used``): the exact
