@@ -13,7 +13,7 @@ import pytest
 from test_kept_parameters import bench_fixture
 
 from fixplan.planner import osculating
-from fixplan.planner.osculating_steps import SETTLE, SOLVED_PAIRS
+from fixplan.planner.osculating_steps import SETTLE, SOLVED_PAIRS, pair_buffers
 from fixplan.planner.planner import Planner
 from fixplan.planner.problem import Load
 
@@ -38,13 +38,7 @@ def upper_factors(rng, shape) -> np.ndarray:
 
 def solved_pairs(forces, friction, rows, noise, factors, twists, units, counted):
     """``SOLVED_PAIRS`` with fresh buffers: the moving pairs' arrays, then the idle ones'."""
-    pairs = forces.size
-    buffers = (
-        np.empty(pairs, dtype=np.int64), np.empty(pairs, dtype=np.int64),
-        np.empty((pairs, 3)), np.empty((pairs, 3)), np.empty(pairs),
-        np.empty(pairs, dtype=np.int64), np.empty(pairs, dtype=np.int64),
-        np.empty((pairs, 3)), np.empty(pairs),
-    )  # fmt: skip
+    buffers = pair_buffers(forces.size)
     moving, idle, finite = SOLVED_PAIRS(forces, friction, rows, noise, factors, twists, units,
                                         counted, *buffers)  # fmt: skip
     assert finite
@@ -245,15 +239,10 @@ def test_each_case_of_a_fixed_force_block_is_held_to_its_own_multiple():
 def test_a_load_that_is_not_finite_keeps_a_round_from_settling():
     forces = np.ones((2, 1))
     friction = np.array([[0.1], [np.nan], [0.3], [0.0], [0.0], [0.0]])
-    buffers = (
-        np.empty(2, dtype=np.int64), np.empty(2, dtype=np.int64), np.empty((2, 3)),
-        np.empty((2, 3)), np.empty(2), np.empty(2, dtype=np.int64),
-        np.empty(2, dtype=np.int64), np.empty((2, 3)), np.empty(2),
-    )  # fmt: skip
     moving, idle, finite = SOLVED_PAIRS(
         forces, friction, np.arange(6).reshape(2, 3), 1e-6, upper_factors(
             np.random.default_rng(13), (2, 1)), np.ones((2, 1, 3)), np.ones((2, 3)),
-        np.ones((2, 1)), *buffers,
+        np.ones((2, 1)), *pair_buffers(2),
     )  # fmt: skip
     assert (moving, idle, finite) == (0, 0, False)  # (the second contact carries no load)
 

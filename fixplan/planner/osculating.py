@@ -43,7 +43,7 @@ import numpy as np
 
 from fixplan.models.exact import Exact
 from fixplan.planner.exact_contacts import ExactContacts
-from fixplan.planner.osculating_steps import SETTLE, SOLVED_PAIRS
+from fixplan.planner.osculating_steps import SETTLE, SOLVED_PAIRS, pair_buffers
 from fixplan.planner.parameters import assign
 from fixplan.tolerances import (
     CAP_RTOL,
@@ -183,13 +183,7 @@ class OsculatingPool(ExactContacts):
         #: The objective value of the last solve (set by :meth:`converge`).
         self._objective: Callable[[], float] = lambda: float("nan")
         #: Buffers of a round's pairs (:func:`~fixplan.planner.osculating_steps.solved_pairs`).
-        pairs = count * cases
-        self._pairs = (
-            np.empty(pairs, dtype=np.int64), np.empty(pairs, dtype=np.int64),
-            np.empty((pairs, 3)), np.empty((pairs, 3)), np.empty(pairs),
-            np.empty(pairs, dtype=np.int64), np.empty(pairs, dtype=np.int64),
-            np.empty((pairs, 3)), np.empty(pairs),
-        )  # fmt: skip
+        self._pairs = pair_buffers(count * cases)
         #: The ellipsoids and cut planes of the last solve (before :meth:`move` moved them).
         self._solved_with = (self._factors.copy(), self._planes.copy())
         self._entries = [(r, c) for r in range(3) for c in range(r, 3)]  # upper triangle

@@ -16,6 +16,16 @@ import numpy as np
 from fixplan.surface.point_kernel import compiled_scalar
 
 
+def pair_buffers(pairs: int) -> tuple:
+    """Output arrays of :func:`solved_pairs` for up to ``pairs`` pairs, in its order."""
+
+    def index():
+        return np.empty(pairs, dtype=np.int64)
+
+    return (index(), index(), np.empty((pairs, 3)), np.empty((pairs, 3)), np.empty(pairs),
+            index(), index(), np.empty((pairs, 3)), np.empty(pairs))  # fmt: skip
+
+
 def solved_pairs(
     forces, friction, rows, noise, factors, twists, units, counted,
     owner, cases, per_unit, used, power, idle_owner, idle_cases, idle_twists, idle_reach,
