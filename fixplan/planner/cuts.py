@@ -92,7 +92,8 @@ class CutPool(ExactContacts):
 
     def converge(self, solve: Callable[[], str], status: str) -> tuple[str, list[str]]:
         """Cut and re-solve (``solve()`` returns the status) from a first solve's ``status``
-        until every exact contact load is inside its surface; the final status and notes."""
+        until every exact contact load is inside its surface (or ``MAX_INACCURATE_IN_A_ROW``
+        solves were inaccurate); the final status and notes."""
         inaccurate = 0
         for _ in range(MAX_CUT_ROUNDS):
             inaccurate = inaccurate + 1 if status == "inaccurate" else 0
