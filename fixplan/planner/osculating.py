@@ -22,10 +22,9 @@ cases are independent; the normals are compared rather than the twist, whose dir
 interior-point solve gives to about 1e-5) and the load must lie on the exact surface: what
 limiting loads left inside their sets cost the objective, to first order their powers ``P =
 L·V`` times the fractions they are inside, at most ``COMPLEMENTARITY_RTOL`` of it (of each
-case's multiple, in a fixed-force block). Loads of
-contacts that do not limit the optimum may be anywhere inside (an optimum's loads are often not
-unique). A fixed-force case whose multiple sits at a bound (0, or
-the cap) needs no stationarity: its exactly feasible loads prove that multiple optimal. A
+case's multiple, in a fixed-force block). Loads of contacts that do not limit the optimum may
+be anywhere inside (an optimum's loads are often not unique). A fixed-force case whose multiple
+sits at a bound (0, or the cap) needs no stationarity: its exactly feasible loads prove that multiple optimal. A
 contact without load (not pressed) that takes part in the impending motion is held at no normal
 force because its set looks too small in the direction of its twist ``V``: its ellipsoid must
 reach as far as the exact set there (``SUPPORT_RTOL``), else it is moved to osculate at the
@@ -276,7 +275,8 @@ class OsculatingPool(ExactContacts):
             PROGRESS, MARGIN, CUT_SLACK,
         )  # fmt: skip
         if slow.any():
-            self._anchor(twists, owner[slow], cases[slow])
+            e, k = owner[slow], cases[slow]
+            self._osculate_at(e, k, twists[e, k] / self._units[e])
         self._assign(cuts=cut)
         return settled and solved
 
@@ -289,12 +289,13 @@ class OsculatingPool(ExactContacts):
         multiples = np.abs(np.asarray(self._scale.value, dtype=float))
         return COMPLEMENTARITY_RTOL * np.maximum(multiples, 1.0)
 
-    def _anchor(self, twists: np.ndarray, owner: np.ndarray, cases: np.ndarray) -> None:
+    def _osculate_at(self, owner: np.ndarray, cases: np.ndarray, twists: np.ndarray) -> None:
         """Move the ellipsoids of the pairs ``(owner, cases)`` to osculate where the exact set's
-        normal is the pair's twist in the solve (see ``PROGRESS``), where those are finite."""
+        normal is the pair's load-space twist ``(P, 3)`` (the pair's twist in the solve: see
+        ``PROGRESS`` and :meth:`_reach`), where those ellipsoids are finite."""
         for model, rows in self._by_model(owner):
             e, k = owner[rows], cases[rows]
-            found = model.osculating_at(twists[e, k] / self._units[e])[1]
+            found = model.osculating_at(twists[rows])[1]
             finite = np.all(np.isfinite(found), axis=(1, 2))
             self._factors[e[finite], k[finite]] = found[finite] * (1.0 + MARGIN)
 
@@ -324,12 +325,7 @@ class OsculatingPool(ExactContacts):
         loose = weights[owner, cases] * (1.0 - reach / exact) > SUPPORT_RTOL
         if not loose.any():
             return True
-        short = np.flatnonzero(loose)
-        for model, rows in self._by_model(owner[short]):
-            e, k = owner[short[rows]], cases[short[rows]]
-            found = model.osculating_at(twists[short[rows]])[1]
-            finite = np.all(np.isfinite(found), axis=(1, 2))
-            self._factors[e[finite], k[finite]] = found[finite] * (1.0 + MARGIN)
+        self._osculate_at(owner[loose], cases[loose], twists[loose])
         return False
 
     def _assign(self, cuts: bool = True) -> None:
