@@ -54,3 +54,9 @@ def test_rounds_of_accurate_solves_that_do_not_converge_end_with_a_note():
     status, notes, solves = _rounds("optimal", ["inaccurate"])
     assert (status, solves) == ("optimal", MAX_CUT_ROUNDS)
     assert len(notes) == 1 and f"after {MAX_CUT_ROUNDS} rounds of cuts" in notes[0]
+
+
+def test_rounds_that_end_on_an_inaccurate_solve_leave_no_note_for_the_fallback_solver():
+    # (The fallback solver's own rounds note a load still outside.)
+    statuses = ["optimal"] * (MAX_CUT_ROUNDS - 1) + ["inaccurate"]
+    assert _rounds("optimal", statuses) == ("inaccurate", [], MAX_CUT_ROUNDS)

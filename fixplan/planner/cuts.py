@@ -93,7 +93,8 @@ class CutPool(ExactContacts):
     def converge(self, solve: Callable[[], str], status: str) -> tuple[str, list[str]]:
         """Cut and re-solve (``solve()`` returns the status) from a first solve's ``status``
         until every exact contact load is inside its surface (or ``MAX_INACCURATE_IN_A_ROW``
-        solves were inaccurate); the final status and notes."""
+        solves were inaccurate); the final status and notes (a load still outside after
+        ``MAX_CUT_ROUNDS`` of accurate solves)."""
         inaccurate = 0
         for _ in range(MAX_CUT_ROUNDS):
             inaccurate = inaccurate + 1 if status == "inaccurate" else 0
@@ -103,7 +104,8 @@ class CutPool(ExactContacts):
             if worst <= EXACT_CUT_RTOL:
                 return status, []
             status = solve()
-        if status in ("optimal", "inaccurate") and (worst := self.add_cuts()) > EXACT_CUT_RTOL:
+        # (An inaccurate last solve goes to the fallback solver, whose rounds note their own.)
+        if status == "optimal" and (worst := self.add_cuts()) > EXACT_CUT_RTOL:
             return status, [
                 f"exact friction models: after {MAX_CUT_ROUNDS} rounds of cuts a contact load "
                 f"still lies {worst:.2g} (relative) outside its limit surface"
