@@ -426,6 +426,46 @@ def test_rounds_slow_to_settle_move_to_the_exact_point_of_the_solves_twist(monke
     assert sum(r for _, r in anchored) < sum(r for _, r in on_rays)
 
 
+def test_load_cases_that_moved_far_start_from_the_axis_ellipsoids(monkeypatch):
+    """A re-solve starts each load case's rounds from the ellipsoids kept for it where its task
+    wrench moved by at most ``START_CHANGE`` of itself, else from those through the exact sets'
+    axis points: on the fixture of benchmarks/bench_planner.py, re-solved under new random
+    milling loads, fewer rounds than from the kept ones, the optima of fresh planners, every
+    load inside."""
+    rounds, starts = [], []
+    pool = osculating_rounds.OsculatingPool
+    move, place = pool.move, pool.place
+    monkeypatch.setattr(pool, "move", lambda self: rounds.append(1) or move(self))
+    monkeypatch.setattr(
+        pool, "place", lambda self, found: starts.append(found) or place(self, found)
+    )
+
+    def re_solved(first, then):
+        planner = Planner(bench_fixture(milling_loads(first), "exact"))
+        planner.solve(analyse=False)
+        rounds.clear()
+        starts.clear()
+        plan = planner.solve(milling_loads(then), analyse=False)
+        assert_loads_inside_their_exact_surfaces(planner.problem, plan)
+        moved = [
+            planner._runner._moved(np.asarray(old.wrench), np.asarray(new.wrench))
+            for old, new in zip(milling_loads(first), milling_loads(then), strict=True)
+        ]
+        far = [found is None for found in starts[0]]
+        assert far == [change > runner.START_CHANGE for change in moved]
+        return plan.objective_value, len(rounds), far
+
+    seeds = [(2 * k + 1, 2 * k + 2) for k in range(6)]  # (20 rounds against 25)
+    found = [re_solved(*pair) for pair in seeds]
+    for (value, _, far), (_, then) in zip(found, seeds, strict=True):
+        assert any(far) and not all(far)
+        fresh = Planner(bench_fixture(milling_loads(then), "exact")).solve(analyse=False)
+        assert value == pytest.approx(fresh.objective_value, rel=OPTIMUM_RTOL)
+    monkeypatch.setattr(runner, "START_CHANGE", math.inf)
+    kept = [re_solved(*pair)[1] for pair in seeds]
+    assert sum(r for _, r, _ in found) < sum(kept)
+
+
 def counted_clarabel_iterations(monkeypatch) -> list:
     """The interior-point iterations of every Clarabel solve from now on: its solver class
     replaced by one that appends them to the list returned (cvxpy's Clarabel interface and the

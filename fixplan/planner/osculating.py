@@ -170,8 +170,10 @@ class OsculatingPool(ExactContacts):
         self._scale = scale
         self._units = np.array([model._units() for model in self._models])  # (E, 3)
         count, cases = len(self._contacts), friction.shape[1]
-        self._factors = np.zeros((count, cases, 3, 3))
-        self._factors[:, :, [0, 1, 2], [0, 1, 2]] = (1.0 + MARGIN) / self._units[:, None, :]
+        #: ``(E, 3, 3)`` the ellipsoids through the exact sets' axis points (a first solve's).
+        self._axis = np.zeros((count, 3, 3))
+        self._axis[:, [0, 1, 2], [0, 1, 2]] = (1.0 + MARGIN) / self._units
+        self._factors = np.repeat(self._axis[:, None], cases, axis=1)
         self._next_slot = np.zeros((count, cases), dtype=int)
         #: ``(E, K)`` the excess of each pair's load in the last round of this solve (NaN: none).
         self._previous_excess = np.full((count, cases), np.nan)
@@ -203,11 +205,11 @@ class OsculatingPool(ExactContacts):
         return self._factors.copy()
 
     def place(self, ellipsoids: list) -> None:
-        """Start from known ellipsoids: ``(E, 3, 3)`` factors per load case (``None`` keeps the
-        case's own). An ellipsoid models its contact's set in any load case."""
+        """Start from known ellipsoids: ``(E, 3, 3)`` factors per load case (``None``: those
+        through the exact sets' axis points). An ellipsoid models its contact's set in any
+        load case."""
         for j, factors in enumerate(ellipsoids):
-            if factors is not None:
-                self._factors[:, j] = factors
+            self._factors[:, j] = self._axis if factors is None else factors
         self._assign()
 
     def follow(self, other: OsculatingPool) -> None:
