@@ -10,7 +10,7 @@ from test_kept_parameters import bench_fixture
 
 from fixplan.planner import cone_interior_point, dual_simplex
 from fixplan.planner.planner import Planner
-from fixplan.planner.problem import Load
+from fixplan.planner.problem import Body, Contact, Load, Problem
 
 #: Clamp force limit [N]: the heavy cut below needs more.
 CLAMP_LIMIT = 150.0
@@ -79,3 +79,34 @@ def test_an_unholdable_load_in_a_control_loop_reports_what_a_fresh_solve_does(
         assert not cold_starts
         assert len(iterations) == (method == "interior point")
         assert all(n < cone_interior_point.MAX_ITERATIONS // 2 for n in iterations)
+
+
+@pytest.mark.parametrize(
+    ("objective", "lifts"),
+    [("min-max-normal-force", [1.0, 2.0, 300.0, 3.0]), ("check", [90.0, -5.0, 5000.0])],
+)
+def test_a_re_solve_after_an_unholdable_direct_one_with_a_given_force_and_a_new_force_unit(
+    objective, lifts
+):
+    """A pinch with a given finger force (both for ``check``), lifted: the direct solve of an
+    unholdable lift, then one in another force unit (which writes the given forces again) —
+    each plan a fresh planner's. (That second re-solve ended in a KeyError: the direct
+    solve's reader was made only once it had an answer.)"""
+    fingers = [("a", -1, 20.0), ("b", 1, 20.0 if objective == "check" else None)]
+    contacts = [
+        Contact(name=name, role="finger", position=[0, 0.05 * side, 0], normal=[0, -side, 0],
+                mu=0.5, model="point-cone", force=force)
+        for name, side, force in fingers
+    ]  # fmt: skip
+    mass = 10.0 if objective == "check" else 0.5
+    problem = Problem(body=Body(mass=mass, center_of_mass=[0, 0, 0]), contacts=contacts,
+                      loads=[Load(name="lift", force=[0, 0, lifts[0]])], objective=objective)  # fmt: skip
+    planner = Planner(problem)
+    for lift in lifts:
+        loads = [Load(name="lift", force=[0, 0, lift])]
+        plan, fresh = planner.solve(loads), Planner(problem).solve(loads)
+        assert plan.status == fresh.status
+        if fresh.status == "optimal":
+            assert plan.objective_value == pytest.approx(fresh.objective_value, rel=1e-7)
+        held = [plan.held_intervals.get("lift", ()), fresh.held_intervals.get("lift", ())]
+        np.testing.assert_allclose(*held, rtol=1e-7)

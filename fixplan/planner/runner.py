@@ -730,14 +730,14 @@ class Runner:
         direct = self._direct.get(key)
         if direct is None:
             return None
+        if key not in self._readers:  # (before any answer: _written asks for it after either)
+            self._readers[key] = Reader.of(stacked, direct)
         if not direct.solved(vector=vector):
             if not direct.infeasible:
                 return None
             result = {"status": "infeasible", "solver": "CLARABEL (direct)", "warnings": [],
                       "dual": direct.dual(stacked.balance)}  # fmt: skip
             return in_newtons(result, unit, key[0])
-        if key not in self._readers:
-            self._readers[key] = Reader.of(stacked, direct)
         reader = self._readers[key]
         answer = values_of(stacked, direct.values()) if reader is None else reader(direct)
         self._source = (key, unit)
