@@ -48,7 +48,7 @@ from fixplan.planner.stacking import REFINE, ContactLayout
 from fixplan.planner.unloading import SqueezeFree
 from fixplan.planner.verify import Verifier
 from fixplan.surface.point_kernel import compiled_scalar
-from fixplan.tolerances import MULTIPLE_ATOL
+from fixplan.tolerances import HELD_RTOL, MULTIPLE_ATOL
 
 
 class Planner:
@@ -209,6 +209,10 @@ class Planner:
             if checked["status"] in ("optimal", "inaccurate"):
                 extra = self._intervals(names, checked, wrenches, planned, progress, off,
                                         lowest=ends.get("lowest"))  # fmt: skip
+                if not all(extra["held"].values()):
+                    status = "inaccurate"
+                    notes.append(_not_held_note(extra["held_intervals"], extra["held"]))
+                    warnings.warn(notes[-1], stacklevel=2)
             else:
                 notes.append(f"safety analysis of the forces found: {checked['status']}")
                 extra = {}
@@ -371,6 +375,23 @@ class Planner:
         out = np.zeros((*normal.shape, 4))
         _PLACED(normal, friction, self._friction_owner, self._friction_component, out)
         return out
+
+
+def _not_held_note(intervals: dict, held: dict) -> str:
+    """The note on the load cases that the forces of a force objective's optimum do not hold
+    (their held ``intervals`` miss 1 by more than ``HELD_RTOL``)."""
+    missed = "; ".join(
+        f"{name!r}: from {low:.9g} to {high:.9g}"
+        for name, (low, high) in intervals.items()
+        if not held[name]
+    )
+    return (
+        f"the forces found hold these load cases only at multiples of their loads that miss 1 "
+        f"by more than {HELD_RTOL:g}: {missed}. The solver's accuracy (about 1e-9 of the "
+        "largest force) moves those multiples that much where the forces are far larger than "
+        "the loads they hold, or must cancel exactly along a direction of the loads: give the "
+        "loads a margin or the contacts more friction."
+    )
 
 
 def placed_wrenches(normal, friction, owner, component, out):  # pragma: no cover - compiled
