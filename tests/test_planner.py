@@ -493,30 +493,51 @@ def test_a_model_object_plans_and_verifies_the_same_whatever_normal_force_it_was
     np.testing.assert_allclose(plan.utilisation, 1.0, rtol=1e-6)
 
 
+def knife_edge_pinch(model: str, along: float) -> Problem:
+    """Two fingers (``model`` on 5 mm disks, mu 0.5) pinching a 1 kg part, with a 0.3 N
+    load across them and ``along`` [N] along their axis (which their forces must cancel)."""
+    contacts = [
+        Contact(name=name, role="finger", position=[0, 0.04 * side, 0], normal=[0, -side, 0],
+                mu=0.5, model=model, patch=pressure.disk(0.005))
+        for name, side in (("left", -1), ("right", 1))
+    ]  # fmt: skip
+    load = Load(name="hold", force=[0.3, along, 0.0], point=[0.01, 0, 0.02])
+    return Problem(body=Body(mass=1.0, center_of_mass=[0, 0, 0]), contacts=contacts,
+                   loads=[load], objective="min-max-normal-force")  # fmt: skip
+
+
 @pytest.mark.parametrize("model", ["ellipsoid", "pyramid"])
 def test_forces_that_hold_their_loads_only_off_the_multiple_one_make_an_inaccurate_plan(model):
     """A pinch whose fingers must cancel a 1e-7 N load along their axis: the forces found
     (about 10 N, accurate to about 1e-9 of that) hold it only at multiples 1e-3 to 1e-2 off 1,
     so the plan is ``inaccurate`` and says why; with 1e-3 N there, ``optimal`` and held."""
-
-    def pinch(along):
-        contacts = [
-            Contact(name=name, role="finger", position=[0, 0.04 * side, 0],
-                    normal=[0, -side, 0], mu=0.5, model=model, patch=pressure.disk(0.005))
-            for name, side in (("left", -1), ("right", 1))
-        ]  # fmt: skip
-        load = Load(name="hold", force=[0.3, along, 0.0], point=[0.01, 0, 0.02])
-        return Problem(body=Body(mass=1.0, center_of_mass=[0, 0, 0]), contacts=contacts,
-                       loads=[load], objective="min-max-normal-force")  # fmt: skip
-
-    with pytest.warns(UserWarning, match="hold these load cases only at multiples") as caught:
-        plan = Planner(pinch(1e-7)).solve()
+    with pytest.warns(UserWarning, match="do not hold every load case at the multiple 1") as caught:
+        plan = Planner(knife_edge_pinch(model, 1e-7)).solve()
     low, high = plan.held_intervals["hold"]
     assert plan.status == "inaccurate" and not plan.held["hold"]
     assert 1e-5 < 1.0 - high < 0.1
-    assert f"'hold': from {low:.9g} to {high:.9g}" in str(caught[0].message)
+    assert f"'hold': {low:.9g} to {high:.9g}" in str(caught[0].message)
     assert str(caught[0].message) in plan.warnings
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        plan = Planner(pinch(1e-3)).solve()
+        plan = Planner(knife_edge_pinch(model, 1e-3)).solve()
     assert plan.status == "optimal" and plan.held["hold"] and not plan.warnings
+
+
+def test_forces_whose_analysis_holds_them_at_no_multiple_make_an_inaccurate_plan(monkeypatch):
+    """Where the safety analysis of the forces found is infeasible (held at no multiple of the
+    loads: a knife-edge balance missed by the solver's accuracy), the plan is ``inaccurate``
+    and says so (here the analysis's solve is made to find that)."""
+    planner = Planner(knife_edge_pinch("ellipsoid", 1e-3))
+    solve = planner._squeeze_free
+
+    def infeasible_check(objective, *args, **kwargs):
+        found = solve(objective, *args, **kwargs)
+        return {**found, "status": "infeasible"} if objective == "check" else found
+
+    monkeypatch.setattr(planner, "_squeeze_free", infeasible_check)
+    monkeypatch.setattr(planner, "_carried_ends", lambda *args: {})
+    with pytest.warns(UserWarning, match="at any multiple of their loads"):
+        plan = planner.solve()
+    assert plan.status == "inaccurate" and plan.held_intervals == {}
+    assert plan.objective_value == pytest.approx(Planner(planner.problem).solve().objective_value)

@@ -196,26 +196,13 @@ class Planner:
         if objective in FIXED_FORCE_OBJECTIVES:
             extra = self._intervals(names, result, wrenches, given, progress, off)
         elif analyse and status == "optimal":
-            planned = {self._index_of[name]: f for name, f in forces.items()}
-            ends = self._carried_ends(wrenches, planned, progress, off)
-            if "highest" in ends:  # the force solve's loads, verified just now
-                ends["highest"].update(normal=result["normal"], friction=result["friction"],
-                                       use=use)  # fmt: skip
-            checked = ends.get("highest") or ends.get("solved")
-            if checked is None:
-                checked = self._squeeze_free(
-                    "check", wrenches, planned, squeezed, progress=progress, disabled=off
-                )
-            if checked["status"] in ("optimal", "inaccurate"):
-                extra = self._intervals(names, checked, wrenches, planned, progress, off,
-                                        lowest=ends.get("lowest"))  # fmt: skip
-                if not all(extra["held"].values()):
-                    status = "inaccurate"
-                    notes.append(_not_held_note(extra["held_intervals"], extra["held"]))
-                    warnings.warn(notes[-1], stacklevel=2)
-            else:
-                notes.append(f"safety analysis of the forces found: {checked['status']}")
-                extra = {}
+            extra, note, held = self._analysis(names, result, use, wrenches, forces, squeezed,
+                                               progress, off)  # fmt: skip
+            if not held:
+                status = "inaccurate"
+                warnings.warn(note, stacklevel=2)
+            if note is not None:
+                notes.append(note)
         else:
             extra = {}
         value = self._active.value(objective, forces, result["scale"])
@@ -229,6 +216,33 @@ class Planner:
         return self._plan(status, value, result["solver"], start, notes, fields)
 
     # -- stages -------------------------------------------------------------------------------
+
+    def _analysis(
+        self, names, result, use, wrenches, forces, squeezed, progress, disabled
+    ) -> tuple[dict, str | None, bool]:
+        """The safety analysis of a force objective's optimum ``result`` (its friction ``use``,
+        verified; its active ``forces`` by name): the plan's fields, a note where it failed or
+        found a load case not held, and whether every case is held (else the optimum's
+        forces are not what the solve claimed, to the solver's accuracy)."""
+        planned = {self._index_of[name]: f for name, f in forces.items()}
+        ends = self._carried_ends(wrenches, planned, progress, disabled)
+        if "highest" in ends:  # the force solve's loads, verified just now
+            ends["highest"].update(normal=result["normal"], friction=result["friction"], use=use)
+        checked = ends.get("highest") or ends.get("solved")
+        if checked is None:
+            checked = self._squeeze_free(
+                "check", wrenches, planned, squeezed, progress=progress, disabled=disabled
+            )
+        if checked["status"] == "infeasible":  # held at no multiple
+            return {}, _not_held_note(None), False
+        if checked["status"] != "optimal" and checked["status"] != "inaccurate":
+            return {}, f"safety analysis of the forces found: {checked['status']}", True
+        extra = self._intervals(names, checked, wrenches, planned, progress, disabled,
+                                lowest=ends.get("lowest"))  # fmt: skip
+        if all(extra["held"].values()):
+            return extra, None, True
+        missed = {n: v for n, v in extra["held_intervals"].items() if not extra["held"][n]}
+        return extra, _not_held_note(missed), False
 
     def _switched_off(self, disabled: Sequence[str]) -> np.ndarray | None:
         """``(C,)`` bool of the contacts named in ``disabled`` (``None`` for none)."""
@@ -377,20 +391,21 @@ class Planner:
         return out
 
 
-def _not_held_note(intervals: dict, held: dict) -> str:
-    """The note on the load cases that the forces of a force objective's optimum do not hold
-    (their held ``intervals`` miss 1 by more than ``HELD_RTOL``)."""
-    missed = "; ".join(
-        f"{name!r}: from {low:.9g} to {high:.9g}"
-        for name, (low, high) in intervals.items()
-        if not held[name]
-    )
+def _not_held_note(intervals: dict | None) -> str:
+    """The note on the load cases that the forces of a force objective's optimum do not hold:
+    their held ``intervals`` miss 1 by more than ``HELD_RTOL`` (``None``: the safety analysis
+    found them held at no multiple)."""
+    if intervals is None:
+        missed = "at any multiple of their loads (the safety analysis found none)"
+    else:
+        missed = f"at the multiple 1 of their loads (within {HELD_RTOL:g}), only at " + "; ".join(
+            f"{name!r}: {low:.9g} to {high:.9g}" for name, (low, high) in intervals.items()
+        )
     return (
-        f"the forces found hold these load cases only at multiples of their loads that miss 1 "
-        f"by more than {HELD_RTOL:g}: {missed}. The solver's accuracy (about 1e-9 of the "
-        "largest force) moves those multiples that much where the forces are far larger than "
-        "the loads they hold, or must cancel exactly along a direction of the loads: give the "
-        "loads a margin or the contacts more friction."
+        f"the forces found do not hold every load case {missed}. The solver's accuracy (about "
+        "1e-9 of the largest force) moves the multiples held that much where the forces are "
+        "far larger than the loads they hold, or must cancel exactly along a direction of the "
+        "loads: give the loads a margin or the contacts more friction."
     )
 
 
