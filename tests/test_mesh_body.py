@@ -89,6 +89,9 @@ def test_a_flat_or_unreadable_mesh_and_a_wrong_mass_are_refused(tmp_path):
     (tmp_path / "bad.stl").write_text("not a mesh")
     with pytest.raises(MeshError, match=r"bad\.stl"):
         read_mesh(tmp_path / "bad.stl")
+    (tmp_path / "part.txt").write_text("0 0 0")
+    with pytest.raises(MeshError, match=r"part\.txt.*file_type 'txt'.*formats .* \.stl"):
+        read_mesh(tmp_path / "part.txt")
     box = trimesh.creation.box(extents=[1.0, 1.0, 1.0])
     with pytest.raises(MeshError, match="exactly one of density"):
         Body.from_mesh(box, density=1.0, mass=1.0)

@@ -34,6 +34,11 @@ def read_mesh(source, *, scale: float = 1.0, where: str = "mesh"):
         where = f"{where} {os.fspath(source)!r}"
         try:
             mesh = trimesh.load(os.fspath(source), force="mesh", process=True)
+        except NotImplementedError as exc:  # (trimesh's word for a format it does not read)
+            raise MeshError(
+                f"{where}: cannot read it: {exc}; mesh formats are those trimesh reads, e.g. "
+                ".stl, .obj, .ply, .off, .glb"
+            ) from None
         except (OSError, ValueError, KeyError, IndexError, TypeError) as exc:
             raise MeshError(f"{where}: cannot read it: {exc}") from None
     elif isinstance(source, trimesh.Trimesh):
