@@ -155,6 +155,23 @@ def test_points_are_normalised_and_zero_weights_dropped():
     assert np.allclose(field.center_of_pressure(), [0.75, 0.0])
 
 
+def test_points_given_twice_are_one_support_carrying_both_weights():
+    field = pressure.points([[0, 0], [0.01, 0], [0, 0], [-0.0, 0.01], [0, 0.01]], [1, 2, 3, 4, 5])
+    merged = pressure.points([[0, 0], [0.01, 0], [0, 0.01]], [4, 2, 9])
+    np.testing.assert_array_equal(field.xy, merged.xy)
+    np.testing.assert_allclose(field.weights, merged.weights, rtol=1e-15)
+
+
+def test_point_weights_down_to_the_bound_are_accepted():
+    field = pressure.points([[0, 0], [0.01, 0]], [1, pressure.MIN_WEIGHT_RATIO])
+    assert field.weights[1] == pytest.approx(pressure.MIN_WEIGHT_RATIO, rel=1e-9)
+
+
+def test_annulus_up_to_the_bound_is_accepted():
+    field = pressure.disk(1.0, "annulus", inner_radius=pressure.MAX_ANNULUS_RATIO)
+    assert field.inner_radius == pressure.MAX_ANNULUS_RATIO
+
+
 def test_points_default_to_equal_weights_and_are_centred():
     field = pressure.points([[0.0, 0.0], [3.0, 0.0], [0.0, 3.0]])
     assert np.allclose(field.weights, 1.0 / 3.0)
@@ -383,6 +400,21 @@ def _inputs():
             lambda: pressure.points([[1, 1], [1, 1]]),
             GeometryError,
             ["two distinct"],
+        ),
+        "skewed point weights": (
+            lambda: pressure.points([[0, 0], [0.01, 0], [0, 0.01]], [1e12, 1e-12, 1e-12]),
+            InvalidArgumentError,
+            ["weights", "1e-10", "0"],
+        ),
+        "a point weight of 1e-300": (
+            lambda: pressure.points([[0, 0], [0.01, 0]], [1, 1e-300]),
+            InvalidArgumentError,
+            ["weights", "1e-10"],
+        ),
+        "annulus thinner than the bound": (
+            lambda: pressure.disk(1.0, "annulus", inner_radius=0.9999),
+            InvalidArgumentError,
+            ["inner_radius", "0.999", "'ring'"],
         ),
         "NaN point": (
             lambda: pressure.points([[0, 0], [math.nan, 1]]),

@@ -732,7 +732,7 @@ class CompiledKernel:
                 hessians,
             )  # fmt: skip
         worst = int(np.argmax(gradient)) if count > 1 else 0
-        if gradient[worst] > INVERSE_GRADIENT_RTOL:
+        if count and gradient[worst] > INVERSE_GRADIENT_RTOL:
             raise not_converged(loads[worst], float(gradient[worst]))
         return safety, twist
 

@@ -232,10 +232,12 @@ class AnnulusKernel(SupportKernel):
     @property
     def parts(self) -> tuple[tuple[DiskKernel, float], ...]:
         """The two uniform disks with their weights (the outer positive, the inner negative)."""
-        s2 = (self.inner_radius / self.radius) ** 2
-        outer = DiskKernel(self.radius, "uniform")
-        inner = DiskKernel(self.inner_radius, "uniform")
-        return (outer, 1.0 / (1.0 - s2)), (inner, -s2 / (1.0 - s2))
+        radius, inner_radius = self.radius, self.inner_radius
+        s2 = (inner_radius / radius) ** 2
+        rest = (radius - inner_radius) * (radius + inner_radius) / radius**2  # 1 - s2, exactly
+        outer = DiskKernel(radius, "uniform")
+        inner = DiskKernel(inner_radius, "uniform")
+        return (outer, 1.0 / rest), (inner, -s2 / rest)
 
     def evaluate(self, twists):
         (outer, wo), (inner, wi) = self.parts

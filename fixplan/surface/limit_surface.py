@@ -55,6 +55,7 @@ from fixplan.surface.pressure import (
     PointsField,
     PolygonField,
     PressureField,
+    check_weight_ratio,
 )
 from fixplan.surface.rules import triangle_rule
 from fixplan.surface.sphere import circle, fibonacci_sphere
@@ -227,8 +228,20 @@ class LimitSurface:
         """Support function ``h(V)`` [W per unit speed] of twists ``(3,)`` or ``(K, 3)`` (0 at
         a zero twist)."""
         twists, single = validation.vector_batch("twist", twist, width=3)
-        values = self._trusted_support(twists)
+        unit, exponents = self._normalized(twists)
+        values = np.ldexp(self._trusted_support(unit), exponents)  # h(c V) = c h(V)
         return float(values[0]) if single else values
+
+    def _normalized(self, twists: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Twists ``(K, 3)`` scaled by powers of two ``2^-e`` (exactly) so that the largest of
+        ``|vx|``, ``|vy|`` and ``size * |w|`` is in ``[0.5, 1)``, and the exponents ``e`` ``(K,)``.
+
+        The kernels square speeds: twists far from unit size (beyond about 1e±154) would
+        underflow or overflow there, though the load is homogeneous of degree 0 in the twist,
+        the support of degree 1 and its Hessian of degree -1."""
+        reach = np.array([1.0, 1.0, self._kernel.size])
+        _, exponents = np.frexp(np.max(np.abs(twists) * reach, axis=1))
+        return np.ldexp(twists, -exponents[:, None]), exponents
 
     def _trusted_support(self, twists: np.ndarray) -> np.ndarray:
         """:meth:`support` ``(K,)`` of finite twists ``(K, 3)`` from a caller that checked them
@@ -246,7 +259,8 @@ class LimitSurface:
         twists, single, zero = _vectors("twist", twist)
         if zero is not None:
             raise InvalidArgumentError(f"twist[{zero}] is zero: the support has no Hessian there")
-        hessians = self._trusted_hessians(twists)
+        unit, exponents = self._normalized(twists)
+        hessians = np.ldexp(self._trusted_hessians(unit), -exponents[:, None, None])
         return hessians[0] if single else hessians
 
     @property
@@ -263,7 +277,7 @@ class LimitSurface:
         twists, single, zero = _vectors("twist", twist)
         if zero is not None:
             raise InvalidArgumentError(f"twist[{zero}] is zero: a body at rest has no sliding load")
-        loads = self._scale * self._kernel.evaluate(twists)[1]
+        loads = self._scale * self._kernel.evaluate(self._normalized(twists)[0])[1]
         return loads[0] if single else loads
 
     def load_at_cor(self, cor, ccw: bool = True) -> np.ndarray:
@@ -529,8 +543,20 @@ def _varying_friction_kernel(field: PressureField, mu: Callable) -> SupportKerne
         return values
 
     if isinstance(field, PointsField):
-        friction = local_mu(field.xy[:, 0], field.xy[:, 1])
-        return PointSetKernel(pose.apply(field.xy), field.weights * friction, discrete=True)
+        friction = field.weights * local_mu(field.xy[:, 0], field.xy[:, 1])
+        rubbing = friction > 0.0
+        if np.count_nonzero(rubbing) == 1:
+            (k,) = np.flatnonzero(rubbing)
+            raise InvalidArgumentError(
+                f"mu(x, y) is positive at one support point only, {field.xy[k].tolist()} (local "
+                "frame): a single point has no torsional friction; use a point-contact model, "
+                "or a mu positive at two or more of the points"
+            )
+        if np.any(rubbing):  # (none: refused by the caller as mu = 0 over the whole patch)
+            check_weight_ratio("mu(x, y) times the weights", friction)
+            friction = friction[rubbing]
+        points = field.xy[rubbing] if np.any(rubbing) else field.xy
+        return PointSetKernel(pose.apply(points), friction, discrete=True)
     from fixplan.surface.function_kernel import FunctionKernel
 
     pressure = None
