@@ -113,6 +113,11 @@ MAX_MASS = 1e7
 #: Largest gravitational acceleration [m/s²] (about 100 g).
 MAX_ACCELERATION = 1e3
 
+#: Smallest mass [kg] (a microgram) and gravity [m/s²] of a pushed part: its support's normal
+#: force, their product, must stay far above where the limit surface's arithmetic underflows
+#: (a part of 1e-300 kg ended in an overflow).
+MIN_PUSHED_MASS, MIN_PUSHED_GRAVITY = 1e-9, 1e-6
+
 #: Largest density [kg/m³] of a body read from a mesh (osmium, the densest element: 22,590).
 MAX_DENSITY = 1e5
 

@@ -220,6 +220,19 @@ def test_an_ellipsoid_fitted_to_an_exact_ellipsoid_recovers_it(with_twists):
     assert result.surface.fit_error < 1e-6
 
 
+@pytest.mark.parametrize("size", [1e-300, 1e300])
+def test_only_the_twists_directions_matter_at_any_size(size):
+    """Twists 1e-300 (or 1e300) times as large give the same fit (the squares of their norms
+    underflowed to 0 before: a NaN in the fit's data)."""
+    truth = ellipsoid_from_matrix(
+        [[0.3, 0.05, -0.02], [0.05, 0.5, 0.03], [-0.02, 0.03, 0.8]], rho=0.04, normal_force=5.0
+    )
+    loads, twists = synthetic(truth, 200, seed=6, noise_force=0.02)
+    expected = fit(loads, twists, normal_force=5.0, holdout=0.0).surface.load_matrix
+    found = fit(loads, twists * size, normal_force=5.0, holdout=0.0).surface.load_matrix
+    np.testing.assert_allclose(found, expected, rtol=1e-9)
+
+
 def test_noise_free_quartic_pairs_recover_the_quartic():
     truth = skewed_quartic()
     loads, twists = synthetic(truth, 300, seed=7)

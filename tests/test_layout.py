@@ -268,3 +268,18 @@ def test_sampled_candidates_are_spread_over_the_faces_and_push_inwards():
     assert spacing > 0.03  # six points on 150 x 100 mm: evenly spread, not clustered
     again = sample_surface(body, template=template, n=6, facing=[0, 0, 1])
     assert all(np.array_equal(a.position, b.position) for a, b in zip(top, again, strict=True))
+
+
+def test_coincident_candidates_keep_the_symmetries_and_the_optimum():
+    """A candidate doubled at the same place (a typing slip, or two fingers allowed on one
+    spot) maps as its twin does: the identity and the mirror across the x axis, on which
+    the twins lie, are found (none was before: the search ended in an error; the mirrors that
+    move them have no image of the twin), and the optimum is the ring's."""
+    problem, candidates, choose = symmetric_case()
+    twin = dataclasses.replace(candidates[0], name="f0-twin")
+    doubled = dataclasses.replace(problem, contacts=(*problem.contacts, twin))
+    search = LayoutSearch(doubled, [*candidates, twin], choose=choose)
+    best = search.run(top=1, mode="exact")
+    assert search.stats.symmetries == 2
+    expected = LayoutSearch(problem, candidates, choose=choose).run(top=1, mode="exact")
+    assert best[0].objective_value == pytest.approx(expected[0].objective_value, rel=OPTIMUM_RTOL)

@@ -225,6 +225,21 @@ def test_a_bad_push_file_is_reported_at_its_key_path(tmp_path, key_path):
     assert any(p == key_path or p.startswith(key_path + ".") for p in paths), paths
 
 
+@pytest.mark.parametrize(("key_path", "smallest"), [("part.mass", "1e-09"),
+                                                      ("support.gravity", "1e-06")])  # fmt: skip
+def test_a_vanishing_normal_force_of_the_support_is_refused_at_its_key_path(
+    tmp_path, key_path, smallest
+):
+    """A part of 1e-300 kg (or under 1e-300 m/s² of gravity) ended in an overflow; its mass and
+    gravity have smallest values, which the message names."""
+    path = tmp_path / "light.toml"
+    path.write_text(_mutated(_set(key_path, 1e-300)), encoding="utf-8")
+    with pytest.raises(ProblemFileError) as error:
+        load_push(path)
+    (issue,) = error.value.issues
+    assert issue.key_path == key_path and f"below {smallest}" in str(error.value)
+
+
 def test_fixplan_check_validates_a_push_file_and_plan_points_to_push(capsys):
     file = str(PROBLEMS / "push-box-flat.toml")
     assert main(["check", file, "--json"]) == EXIT_OK

@@ -2,7 +2,9 @@
 Dask cluster, failing cases kept in their rows, resumption, command-line errors."""
 
 import dataclasses
+import errno
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -179,6 +181,8 @@ def test_the_command_line_sends_the_cases_to_an_existing_scheduler(client, tmp_p
         ("contacts[1].role=0:1:2", [], "holds str 'locator'; only numbers vary"),
         ("bodyy.mass=1:2:2", [], "bodyy: the file has no such table or array"),
         ("contacts.1.mu=1:2:2", [], "not a key path"),
+        ("contacts[1].mu=0.2:0.4:3", ["--workers", "100000"], "--workers must be from 0 to"),
+        ("contacts[1].mu=0.2:0.4:3", ["--workers", "-1"], "--workers must be from 0 to"),
     ],
 )
 def test_bad_variations_are_invalid_input_with_a_clear_message(
@@ -190,3 +194,22 @@ def test_bad_variations_are_invalid_input_with_a_clear_message(
     assert message in err
     assert "Traceback" not in err
     assert not (tmp_path / "out").exists()
+
+
+def test_an_output_folder_that_cannot_be_made_is_invalid_input(tmp_path, capsys, monkeypatch):
+    """``--out`` where the folder cannot be made although its parent looks writable (/proc/x,
+    as root, ended in an unexpected error): here a read-only file system."""
+
+    def read_only(self, *args, **kwargs):
+        raise OSError(errno.EROFS, os.strerror(errno.EROFS), str(self))
+
+    monkeypatch.setattr(Path, "mkdir", read_only)
+    argv = ["sweep", str(FIXTURE), "--vary", "contacts[1].mu=0.2:0.4:3", "--out",
+            str(tmp_path / "out"), "--workers", "0"]  # fmt: skip
+    assert main(argv) == EXIT_INVALID_INPUT
+    assert "cannot make it: Read-only file system" in capsys.readouterr().err
+
+
+def test_a_local_cluster_of_more_workers_than_the_machine_runs_is_refused():
+    with pytest.raises(InvalidArgumentError, match="workers must be an integer from 1 to"):
+        fixplan.sweep.run(FIXTURE, "contacts[6].mu=0.2:0.3:3", workers=10**5)

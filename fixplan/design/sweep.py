@@ -37,6 +37,9 @@ from fixplan.planner.problem import Problem
 CHUNK_SIZE = 16
 #: ``client`` value that solves the cases one after another in this process, without Dask.
 SERIAL = "serial"
+#: Most workers of a local cluster per core of the machine: each is a process with the solver
+#: stack, and more only queue for the cores and fill the memory (100,000 never started).
+WORKERS_PER_CORE = 4
 STATUS_INVALID = "invalid input"
 STATUS_ERROR = "error"
 #: Columns of a sweep table after the case id and the varied keys (then one safety factor
@@ -61,6 +64,11 @@ class CaseSource(Protocol):
 
     def structure(self, values: Mapping[str, float]) -> Hashable:
         """Equal for two cases whose problems differ only in their loads."""
+
+
+def most_workers() -> int:
+    """The most workers of a local cluster on this machine (``WORKERS_PER_CORE`` per core)."""
+    return WORKERS_PER_CORE * (os.cpu_count() or 1)
 
 
 def load_column(name: str) -> str:
@@ -138,8 +146,15 @@ def run_cases(
     from distributed import Client, LocalCluster
 
     workers = (os.cpu_count() or 1) if workers is None else workers
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise InvalidArgumentError(f"workers must be a positive integer, got {workers!r}")
+    if (
+        isinstance(workers, bool)
+        or not isinstance(workers, int)
+        or not 1 <= workers <= most_workers()
+    ):
+        raise InvalidArgumentError(
+            f"workers must be an integer from 1 to {most_workers()} ({WORKERS_PER_CORE} per core "
+            f"of this machine), got {workers!r}"
+        )
     with (
         LocalCluster(  # its web server on a free port: several sweeps may run side by side
             n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0"

@@ -65,15 +65,15 @@ def _permutation(problem, models, candidates, center, flip, length_scale):
     permutation = np.full(len(contacts), -1)
     for i, contact in enumerate(contacts):
         for j, other in enumerate(contacts):
-            if _maps_contact(contact, other, models[i], models[j], center, flip, length_scale) and (
-                (i in candidates) == (j in candidates)
+            # (Each image once: coincident contacts, alike, take their images in turn.)
+            if j not in permutation and (
+                _maps_contact(contact, other, models[i], models[j], center, flip, length_scale)
+                and (i in candidates) == (j in candidates)
             ):
                 permutation[i] = j
                 break
         else:
             return None
-    if len(set(permutation.tolist())) != len(contacts):
-        return None
     return permutation
 
 

@@ -859,8 +859,6 @@ def _sweep_client(args: argparse.Namespace):
             raise InvalidArgumentError(
                 f"--scheduler {args.scheduler}: cannot connect to a Dask scheduler there: {exc}"
             ) from None
-    if args.workers is not None and args.workers < 0:
-        raise InvalidArgumentError(f"--workers must be 0 or more, got {args.workers}")
     return SERIAL if args.workers == 0 else None
 
 
@@ -880,6 +878,7 @@ def _sweep_table(args: argparse.Namespace) -> Path:
 
 def _run_sweep(args: argparse.Namespace) -> tuple[int, str]:
     from fixplan.design import CHUNK_SIZE, SERIAL
+    from fixplan.design.sweep import WORKERS_PER_CORE, most_workers
     from fixplan.io.key_path import KeyPathError
     from fixplan.io.sweep import FileCases, cases_of, run
     from fixplan.io.sweep_figures import write_sweep_figures
@@ -889,13 +888,23 @@ def _run_sweep(args: argparse.Namespace) -> tuple[int, str]:
         import distributed  # noqa: F401 - sets its loggers' levels when first imported
 
         logging.getLogger("distributed").setLevel(logging.ERROR)  # no cluster chatter
+    most = most_workers()
+    if args.workers is not None and not 0 <= args.workers <= most:
+        raise InvalidArgumentError(
+            f"--workers must be from 0 to {most} ({WORKERS_PER_CORE} per core of this machine: "
+            f"a local cluster's workers are its processes; for more, start a Dask cluster and "
+            f"give --scheduler), got {args.workers}"
+        )
     cases = cases_of(args.vary, method=args.method, samples=args.samples, seed=args.seed)
     try:
         FileCases.read(args.file, list(cases.columns), objective=args.objective)
     except KeyPathError as exc:
         raise InvalidArgumentError(f"--vary {exc} (in {args.file})") from None
     table_path = _sweep_table(args)
-    args.out.mkdir(parents=True, exist_ok=True)
+    try:
+        args.out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InvalidArgumentError(f"--out {args.out}: cannot make it: {exc.strerror}") from None
     client = _sweep_client(args)
     where = (
         "in this process" if client == SERIAL

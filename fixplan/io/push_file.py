@@ -81,6 +81,8 @@ from fixplan.tolerances import (
     MAX_SPEED,
     MAX_STEPS,
     MIN_MU,
+    MIN_PUSHED_GRAVITY,
+    MIN_PUSHED_MASS,
 )
 
 KIND = "push"
@@ -112,8 +114,9 @@ _POSE = Array((3,), Number("", MAX_LENGTH, "m or rad"))
 _VELOCITY = Array((2,), Number("", MAX_SPEED, "m/s"))
 _DIRECTION = Array((2,))
 _VERTICES = Array((None, 2), _COORDINATE, MAX_POLYGON_VERTICES)
-_MASS = Number("> 0", MAX_MASS, "kg")
-_GRAVITY = Number("> 0", MAX_ACCELERATION, "m/s^2")
+_MASS = Number("> 0", MAX_MASS, "kg", smallest=MIN_PUSHED_MASS, why_smallest="(a microgram)")
+_GRAVITY = Number("> 0", MAX_ACCELERATION, "m/s^2", smallest=MIN_PUSHED_GRAVITY,
+                  why_smallest="(its normal force would vanish in the arithmetic)")  # fmt: skip
 _SUPPORT_MU = Number("> 0", MAX_MU, smallest=MIN_MU, why_smallest="(rounding noise)")
 _PUSHER_MU = Number(">= 0", MAX_MU)
 _RADIUS = Number(">= 0", MAX_LENGTH, "m")

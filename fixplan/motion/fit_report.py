@@ -189,7 +189,9 @@ def _rows(name: str, value) -> np.ndarray:
 
 
 def measured_pairs(loads, twists) -> tuple[np.ndarray, np.ndarray | None]:
-    """Loads and (optional) twists as :func:`_rows`, of the same shape."""
+    """Loads and (optional) twists as :func:`_rows`, of the same shape; each twist divided by
+    its largest entry (only their directions matter, and their squares stay finite at any
+    size)."""
     loads = _rows("loads", loads)
     if twists is None:
         return loads, None
@@ -198,7 +200,7 @@ def measured_pairs(loads, twists) -> tuple[np.ndarray, np.ndarray | None]:
         raise InvalidArgumentError(
             f"twists must have the shape of loads {loads.shape}, got {twists.shape}"
         )
-    return loads, twists
+    return loads, twists / np.abs(twists).max(axis=1, keepdims=True)
 
 
 def _angles(a: np.ndarray, b: np.ndarray) -> np.ndarray:
