@@ -147,3 +147,15 @@ def test_annulus_max_moment_is_the_exact_ratio_of_cubes_to_squares(ratio):
     big, small = Fraction(radius), Fraction(inner)
     exact = float(Fraction(2, 3) * (big**3 - small**3) / (big**2 - small**2))
     assert ls.max_moment == pytest.approx(exact, rel=1e-13)
+
+
+@pytest.mark.parametrize(("mu", "normal_force", "named"), [(0.5, 1e-200, "normal_force"),
+                                                           (1e-120, 1.0, "mu \\* normal_force")])  # fmt: skip
+def test_friction_forces_where_the_arithmetic_underflows_are_refused(mu, normal_force, named):
+    """(A surface of 1e-200 N gave NaN safety factors; 1e-100 N is still exact, scaled.)"""
+    with pytest.raises(InvalidArgumentError, match=f"{named} = .* below 1e-100 N"):
+        LimitSurface(pressure.disk(0.01), mu=mu, normal_force=normal_force)
+    tiny, unit = (LimitSurface(pressure.disk(0.01), mu=1.0, normal_force=f) for f in (1e-100, 1.0))
+    load = np.array([0.15, 0.1, 0.001])
+    assert tiny.safety_factor(1e-100 * load) == pytest.approx(unit.safety_factor(load), rel=1e-12)
+    np.testing.assert_allclose(tiny.motion(1e-100 * load), unit.motion(load), rtol=1e-12)

@@ -461,6 +461,16 @@ def _inputs():
             InvalidArgumentError,
             ["x", "at least two"],
         ),
+        "grid cells below a nanometre": (
+            lambda: pressure.grid([0, 1e-11], [0, 0.01], np.ones((2, 2))),
+            InvalidArgumentError,
+            ["x", "1e-11 m wide", "at least 1e-09 m"],
+        ),
+        "grid of a needle's sides": (
+            lambda: pressure.grid([0, 1e-8], [0, 0.01], np.ones((2, 2))),
+            InvalidArgumentError,
+            ["2e-08 m by 0.02 m", "above 100000"],
+        ),
         "grid values of the wrong shape": (
             lambda: pressure.grid([0, 1], [0, 1], np.ones((3, 2))),
             InvalidArgumentError,

@@ -59,7 +59,7 @@ from fixplan.surface.pressure import (
 )
 from fixplan.surface.rules import triangle_rule
 from fixplan.surface.sphere import circle, fibonacci_sphere
-from fixplan.tolerances import CONTAINMENT_RTOL
+from fixplan.tolerances import CONTAINMENT_RTOL, MIN_FRICTION_FORCE
 
 #: Gauss order per triangle of the far-field rule of polygons (exact to machine precision for
 #: centres of rotation beyond FAR_FIELD_RADII patch radii).
@@ -123,6 +123,14 @@ class LimitSurface:
         else:
             mu = validation.nonnegative_scalar("mu", mu)
             kernel, scale = _field_kernel(field), mu * normal_force
+        if normal_force < MIN_FRICTION_FORCE or 0.0 < scale < MIN_FRICTION_FORCE:
+            small = normal_force < MIN_FRICTION_FORCE
+            what, value = ("normal_force", normal_force) if small else ("mu * normal_force", scale)
+            raise InvalidArgumentError(
+                f"{what} = {value!r} N is below {MIN_FRICTION_FORCE:g} N, "
+                "where the surface's arithmetic underflows (give mu = 0 for a frictionless "
+                "contact)"
+            )
         self.field = field
         self._mu = mu
         self._normal_force = normal_force

@@ -35,28 +35,17 @@ from fixplan.surface.geometry import (
     triangulate,
 )
 from fixplan.surface.rules import gauss_jacobi_unit, triangle_rule
+from fixplan.tolerances import (
+    MAX_ANNULUS_RATIO,
+    MAX_ASPECT_RATIO,
+    MIN_PATCH_LENGTH,
+    MIN_WEIGHT_RATIO,
+)
 
 DISK_PROFILES = ("uniform", "hertz", "parabolic", "annulus", "ring")
 
 #: Exponent ``alpha`` of ``p ∝ (1 - r²/R²)^alpha`` for the profiles of that family.
 _PROFILE_EXPONENT = {"uniform": 0.0, "hertz": 0.5, "parabolic": 1.0}
-
-#: Largest ``inner_radius / radius`` of an annulus. Its closed form is the difference of two
-#: uniform disks weighted ``1 / (1 - s²)`` and ``s² / (1 - s²)`` (``s`` this ratio), which
-#: multiplies their rounding by ``1 / (1 - s²)``: at ``s = 0.999`` support values and
-#: ``max_moment`` within 2e-14 of exact, ``safety_factor(load(V))`` within 1.4e-12 of 1 and no
-#: failure of the inverse map in 5,000 random loads; at 0.9999 the line search of Newton's method
-#: meets that rounding (a load whose inverse map fails), at ``1 - 1e-12`` ``max_moment`` is
-#: 2.5e-5 off. A ring this thin is the profile ``"ring"`` to within its relative thickness.
-MAX_ANNULUS_RATIO = 0.999
-
-#: Smallest ratio of a point support's positive weight (or friction weight, with ``mu(x, y)``)
-#: to the largest. Below it the point next to the heavy one is a torsion the inverse map cannot
-#: resolve in double precision: on points at the corners of a right triangle with weights
-#: ``(1, r, r)`` and on two points with ``(1, r)`` (1,000 random loads each),
-#: ``safety_factor(load(motion(L)))`` is within 2e-15 of 1 down to ``r = 1e-10``, 6e-13 at
-#: 1e-11, 8e-11 at 1e-12, and from 1e-14 the inverse map fails (3 to 400 loads in 1,000).
-MIN_WEIGHT_RATIO = 1e-10
 
 #: Default quadrature order (Gauss nodes per dimension and panel) of :meth:`quadrature`.
 DEFAULT_ORDER = 24
@@ -434,6 +423,18 @@ def grid(x, y, values, *, centered: bool = True) -> GridField:
             raise InvalidArgumentError(
                 f"{name} must hold at least two cell centres to define the cell size"
             )
+        if steps[0] < MIN_PATCH_LENGTH:
+            raise InvalidArgumentError(
+                f"{name}: cells {float(steps[0])!r} m wide; at least {MIN_PATCH_LENGTH:g} m (below it "
+                "the limit surface's arithmetic underflows)"
+            )
+    extents = (len(xs) * float(xs[1] - xs[0]), len(ys) * float(ys[1] - ys[0]))
+    if max(extents) > MAX_ASPECT_RATIO * min(extents):
+        raise InvalidArgumentError(
+            f"the grid is {extents[0]!r} m by {extents[1]!r} m: its sides' ratio is above "
+            f"{MAX_ASPECT_RATIO:g} (the inverse map loses accuracy on needles); model so thin a "
+            "strip as points along a line"
+        )
     if np.any(vals < 0.0):
         j, i = np.argwhere(vals < 0.0)[0]
         raise InvalidArgumentError(f"values must be >= 0, got {vals[j, i]!r} at values[{j}][{i}]")
