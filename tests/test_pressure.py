@@ -528,3 +528,14 @@ def test_bad_input_raises_an_error_naming_the_argument_and_its_range(name):
     message = str(caught.value)
     for word in words:
         assert word in message, f"{word!r} missing from {message!r}"
+
+
+def test_measurable_weights_drop_an_engines_rim_that_points_refuses():
+    """A rim of 1e-15 of the peak (a hydroelastic engine's outer polygons) is refused by
+    ``points`` and dropped by ``measurable``; weights at the ratio stay."""
+    xy, weights = [[0, 0], [0.01, 0], [0, 0.01]], [1.0, 1e-15, pressure.MIN_WEIGHT_RATIO]
+    with pytest.raises(InvalidArgumentError, match="below 1e-10 of the largest"):
+        pressure.points(xy, weights)
+    np.testing.assert_array_equal(pressure.measurable(weights), [1.0, 0.0, 1e-10])
+    field = pressure.points(xy, pressure.measurable(weights), centered=False)
+    np.testing.assert_allclose(field.xy, [[0, 0], [0, 0.01]])

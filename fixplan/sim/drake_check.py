@@ -176,7 +176,7 @@ def hydroelastic_check(
     at_rest = scene.context.Clone()
     xy, areas, pressures = scene.patch()
     force = areas * pressures
-    field = pressure.points(xy, force, centered=False)
+    field = pressure.points(xy, pressure.measurable(force), centered=False)
     surface = LimitSurface(field, mu=mu, normal_force=normal_force)
     ellipsoid = Ellipsoid.from_limit_surface(surface)
     results = []

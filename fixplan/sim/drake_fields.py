@@ -105,9 +105,9 @@ def profile_deviation(
 
 
 def _loaded(patch: EnginePatch) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Pressures [Pa], areas [m²] and centroids [m] of the polygons with positive pressure
-    (read-only arrays)."""
-    loaded = patch.pressures > 0.0
+    """Pressures [Pa], areas [m²] and centroids [m] of the polygons with measurable force
+    (:func:`~fixplan.surface.pressure.measurable`; read-only arrays)."""
+    loaded = pressure.measurable(patch.pressures * patch.areas) > 0.0
     arrays = tuple(np.array(a[loaded], dtype=float) for a in (patch.pressures, patch.areas))
     xy = np.array(patch.xy[loaded], dtype=float)
     for array in (*arrays, xy):

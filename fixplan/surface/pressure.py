@@ -375,6 +375,15 @@ def points(xy, weights=None, *, centered: bool = True) -> PointsField:
     return PointsField(xy=xy_array, weights=w)
 
 
+def measurable(weights) -> np.ndarray:
+    """``weights`` with those below ``MIN_WEIGHT_RATIO`` of the largest set to 0: the rims of a
+    field measured by a sensor or computed by an engine (forces of 1e-15 of the peak), which
+    :func:`points` refuses."""
+    weights = np.array(weights, dtype=float)
+    weights[weights < MIN_WEIGHT_RATIO * weights.max(initial=0.0)] = 0.0
+    return weights
+
+
 def check_weight_ratio(name: str, weights: np.ndarray) -> None:
     """Raise unless every positive entry of ``weights`` is at least :data:`MIN_WEIGHT_RATIO`
     of the largest."""
@@ -486,6 +495,7 @@ __all__ = [
     "disk",
     "from_function",
     "grid",
+    "measurable",
     "points",
     "polygon",
     "rectangle",
