@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from fixplan import LimitSurface, pressure
-from fixplan.errors import InvalidArgumentError
+from fixplan.errors import GeometryError, InvalidArgumentError
 from fixplan.models import Ellipsoid
-from fixplan.motion import Outline, PointPusher, push
+from fixplan.motion import LinePusher, Outline, PointPusher, push
 
 SUPPORT = LimitSurface(pressure.rectangle(0.1, 0.06), mu=0.4, normal_force=5.0)
 ELLIPSOID = Ellipsoid.from_limit_surface(SUPPORT)
@@ -175,3 +175,42 @@ def test_outline_distance_is_negative_exactly_inside_a_star_shaped_outline():
         turns = np.diff(np.append(seen, seen[0]))
         winding = np.sum((turns + np.pi) % (2 * np.pi) - np.pi) / (2 * np.pi)
         assert (star.nearest(point)[2] < 0.0) == (abs(round(winding)) == 1)
+
+
+@pytest.mark.parametrize(("start", "radius"), [([-0.06, 0.015], 0.1), ([-0.06, 0.015], 1000.0),
+                                               ([-0.045, 0.03], 0.005), ([0.0, 0.0], 0.0)])  # fmt: skip
+def test_a_pusher_that_starts_inside_the_part_is_refused_with_its_overlap(start, radius):
+    box = Outline.rectangle(0.09, 0.06)
+    table = LimitSurface(pressure.rectangle(0.09, 0.06), mu=0.3, normal_force=0.5 * 9.81)
+    finger = PointPusher((start, [0.02, 0.0]), mu=0.25, radius=radius)
+    with pytest.raises(GeometryError, match=f"radius {radius:g} m .* overlaps the part"):
+        push(table, finger, shape=box, duration=1.0, steps=10)
+
+
+def test_a_flat_pusher_that_starts_inside_the_part_is_refused():
+    box = Outline.rectangle(0.09, 0.06)
+    table = LimitSurface(pressure.rectangle(0.09, 0.06), mu=0.3, normal_force=0.5 * 9.81)
+    face = LinePusher(([-0.04, 0.0], [0.02, 0.0]), mu=0.25, width=0.15)
+    with pytest.raises(
+        GeometryError, match=r"overlaps the part at pose \(0\.0, 0\.0, 0\.0\) by 0\.005 m"
+    ):
+        push(table, face, shape=box, duration=1.0, steps=10)
+
+
+@pytest.mark.parametrize("start", [[-0.045, 0.03], [-0.03, 0.03], [0.045, -0.03]])
+def test_a_point_pusher_moving_along_an_edge_of_the_part_does_not_push_it(start):
+    box = Outline.rectangle(0.09, 0.06)
+    table = LimitSurface(pressure.rectangle(0.09, 0.06), mu=0.3, normal_force=0.5 * 9.81)
+    finger = PointPusher((start, [0.02 if start[1] > 0 else -0.02, 0.0]), mu=0.25)
+    pushed = push(table, finger, shape=box, duration=1.0, steps=50)
+    assert set(pushed.modes) == {"separated"}
+    np.testing.assert_array_equal(pushed.poses, 0.0)
+    np.testing.assert_array_equal(pushed.forces, 0.0)
+
+
+def test_a_point_pusher_at_a_corner_moving_into_the_part_pushes_it():
+    box = Outline.rectangle(0.09, 0.06)
+    table = LimitSurface(pressure.rectangle(0.09, 0.06), mu=0.3, normal_force=0.5 * 9.81)
+    finger = PointPusher(([-0.045, 0.03], [0.02, -0.01]), mu=0.25)
+    pushed = push(table, finger, shape=box, duration=1.0, steps=50)
+    assert pushed.modes[0] != "separated" and pushed.poses[-1][0] > 0.0

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from fixplan import LimitSurface, pressure
-from fixplan.errors import InvalidArgumentError
+from fixplan.errors import InvalidArgumentError, ModelError
 from fixplan.models import Ellipsoid, Exact, FittedEllipsoid
 from fixplan.motion import FittedQuartic, motion_cone, push_step
 from fixplan.motion.fitted_quartic import monomials
@@ -396,3 +396,19 @@ def test_a_quartic_step_through_its_inverse_map_is_the_step_through_its_forward_
         np.testing.assert_allclose(step.load, reference.load, rtol=0.0,
                                    atol=ROUTES_RTOL * np.linalg.norm(reference.load))  # fmt: skip
     assert {"sticking", "sliding-left", "sliding-right"} <= modes
+
+
+@pytest.mark.parametrize("contact", [[1.0, 0.0], [1000.0, 0.0], [1.0, 1e-9]])
+def test_a_motion_cone_whose_edge_does_not_push_the_part_away_is_refused_and_every_push_sticks(
+    contact,
+):
+    # On the line of a two-point support an edge force turns the part about a support point:
+    # the contact moves along the tangent (or, off the line, slightly into the pusher).
+    pair = LimitSurface(pressure.points([[-0.04, 0.0], [0.04, 0.0]]), mu=0.3, normal_force=4.9)
+    with pytest.raises(ModelError, match="normal speed"):
+        motion_cone(pair, contact=contact, normal=[1, 0], mu=0.25)
+    for velocity in ([1.0, 0.0], [1.0, 5.0], [1.0, -5.0], [1e-3, 1.0]):
+        step = push_step(pair, contact=contact, normal=[1, 0], velocity=velocity, mu=0.25)
+        assert step.mode == "sticking"
+    cone = motion_cone(pair, contact=[0.1, 0.0], normal=[1, 0], mu=0.25)
+    assert cone.left[0] == pytest.approx(1.0) and cone.right[0] == pytest.approx(1.0)

@@ -291,3 +291,38 @@ def test_a_swinging_push_slides_the_puck_in_steps_stick_slip_as_the_closed_form_
     np.testing.assert_allclose(sliding.poses[:, 0], [expected_x(t) for t in sliding.t], rtol=0.0,
                                atol=1e-9)  # fmt: skip
     np.testing.assert_allclose(sliding.poses[:, 1:], 0.0, rtol=0.0, atol=1e-12)
+
+
+# -- runs that stop before the first sample, loads on the surface ---------------------------------
+
+RECT = LimitSurface(pressure.rectangle(0.09, 0.06), mu=0.3, normal_force=0.5 * 9.81)
+
+
+@pytest.mark.parametrize(("duration", "samples"), [(100.0, 200), (1e5, 200), (1.0, 2), (1.0, 1)])
+def test_a_body_that_stops_before_the_first_sample_stops_where_newton_says(duration, samples):
+    # Pure translation on a rectangle: m v' = -mu N, stop at v0 m / (mu N), after v0² m / 2 mu N.
+    deceleration = 0.3 * 9.81
+    sliding = slide(RECT, mass=0.5, inertia=1e-3, twist0=[1.0, 0.0, 0.0], duration=duration,
+                    samples=samples)  # fmt: skip
+    assert sliding.t[1] == sliding.stopped < duration / samples
+    assert sliding.stopped == pytest.approx(1.0 / deceleration, rel=1e-3)
+    np.testing.assert_allclose(sliding.poses[-1], [0.5 / deceleration, 0.0, 0.0], rtol=0.0,
+                               atol=1e-7)  # fmt: skip
+    assert sliding.t[-1] == duration and len(sliding.t) == samples + 2
+    np.testing.assert_array_equal(sliding.twists[1:], 0.0)
+
+
+def test_a_push_of_exactly_mu_n_leaves_a_body_at_rest_and_a_larger_one_slides_it():
+    surface = LimitSurface(pressure.rectangle(0.09, 0.06), mu=0.3, normal_force=4.9)
+    limit = 0.3 * 4.9
+    assert surface.safety_factor([limit, 0.0, 0.0]) < 1.0  # rounding puts it just outside
+    held = slide(surface, mass=0.5, inertia=1e-3, twist0=[0, 0, 0], duration=1.0,
+                 load=lambda t, pose: [limit, 0.0, 0.0])  # fmt: skip
+    assert held.stopped == 0.0 and held.starts == ()
+    np.testing.assert_array_equal(held.poses, 0.0)
+    push = 1.001 * limit
+    moved = slide(surface, mass=0.5, inertia=1e-3, twist0=[0, 0, 0], duration=1.0,
+                  load=lambda t, pose: [push, 0.0, 0.0])  # fmt: skip
+    assert moved.starts == (0.0,) and moved.stopped is None
+    np.testing.assert_allclose(moved.poses[-1], [(push - limit) / 0.5 / 2, 0.0, 0.0], rtol=1e-6,
+                               atol=1e-12)  # fmt: skip

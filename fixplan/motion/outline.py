@@ -22,6 +22,9 @@ import numpy as np
 from fixplan import validation
 from fixplan.surface.geometry import simple_polygon
 
+#: A point within this fraction of the longest edge of a polygon lies on its outline (rounding).
+ON_OUTLINE_RTOL = 1e-12
+
 
 @dataclass(frozen=True, slots=True)
 class Outline:
@@ -68,15 +71,47 @@ class Outline:
         best = int(np.argmin(gaps))
         inside = _inside(self.vertices, point)
         gap = float(gaps[best])
-        if gap > 0.0 and not inside:
+        # A point on an edge has a gap of rounding size, along any direction: the edge's normal,
+        # not that direction, is the normal there.
+        slack = ON_OUTLINE_RTOL * np.abs(edge).max()
+        if gap > slack and not inside:
             normal = (point - closest[best]) / gap
         else:  # on or inside the outline: the edge's outward normal (a corner: the bisector)
-            normals = np.column_stack([edge[:, 1], -edge[:, 0]])
-            normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-            touching = np.flatnonzero(gaps <= gap + 1e-12 * max(gap, np.abs(edge).max()))
-            normal = normals[touching].sum(axis=0)
-            normal /= np.linalg.norm(normal)
+            normals = self._edge_normals(point)
+            normal = normals.sum(axis=0)
+            length = np.linalg.norm(normal)
+            # Inside, equally far from opposite edges: the first one's.
+            normal = normal / length if length > 0.0 else normals[0]
         return closest[best], normal, -gap if inside else gap
+
+    def enters(self, point, direction) -> bool:
+        """Whether a point on the outline moving along ``direction`` (part frame) goes into the
+        part: into the inner side of its edge, and at a corner of the inner sides of both edges
+        (a convex corner) or of either (a reflex one). A disk: against its outward normal."""
+        point = np.asarray(point, dtype=float)
+        direction = np.asarray(direction, dtype=float)
+        if not len(self.vertices):
+            return float(direction @ point) < 0.0
+        normals = self._edge_normals(point)
+        inward = normals @ direction < 0.0
+        if len(normals) == 1:
+            return bool(inward[0])
+        return bool(inward.all() if _turns_left(self.vertices, point) else inward.any())
+
+    def _edge_normals(self, point: np.ndarray) -> np.ndarray:
+        """The outward unit normals of the edges nearest to ``point`` (two at a corner), in
+        the order of the edges."""
+        start = self.vertices
+        edge = np.roll(self.vertices, -1, axis=0) - start
+        along = np.clip(np.einsum("ij,ij->i", point - start, edge) / np.einsum("ij,ij->i", edge, edge),
+                        0.0, 1.0)  # fmt: skip
+        gaps = np.linalg.norm(point - (start + along[:, None] * edge), axis=1)
+        gap = float(gaps.min())
+        touching = np.flatnonzero(gaps <= gap + ON_OUTLINE_RTOL * max(gap, np.abs(edge).max()))
+        if len(touching) == 2 and touching[0] == 0 and touching[1] == len(edge) - 1:
+            touching = touching[::-1]  # the last edge and the first meet at vertex 0
+        normals = np.column_stack([edge[touching, 1], -edge[touching, 0]])
+        return normals / np.linalg.norm(normals, axis=1, keepdims=True)
 
     def face_points(self, centre, normal, half_width: float) -> FacePoints:
         """The points of the outline that a flat face can touch (see the module docstring).
@@ -167,3 +202,11 @@ def _inside(vertices: np.ndarray, point: np.ndarray) -> bool:
     with np.errstate(divide="ignore", invalid="ignore"):
         crossing = x0 + (y - y0) * (x1 - x0) / (y1 - y0)
     return bool(np.count_nonzero(straddles & (x < crossing)) % 2)
+
+
+def _turns_left(vertices: np.ndarray, point: np.ndarray) -> bool:
+    """Whether the counter-clockwise outline turns left (a convex corner) at the vertex nearest
+    to ``point``."""
+    k = int(np.argmin(np.linalg.norm(vertices - point, axis=1)))
+    before, after = vertices[k] - vertices[k - 1], vertices[(k + 1) % len(vertices)] - vertices[k]
+    return bool(before[0] * after[1] - before[1] * after[0] > 0.0)

@@ -177,12 +177,34 @@ def push_step(surface, *, contact, normal, velocity, mu: float) -> PushStep:
 def motion_cone(surface, *, contact, normal, mu: float) -> MotionCone:
     """The motion cone of a pusher at ``contact`` (Mason; Lynch, Maekawa & Tanie 1992): the
     twists of the two edge forces of its friction cone, each at unit normal speed of the contact
-    point. Arguments as for :func:`push_step`."""
+    point. Arguments as for :func:`push_step`.
+
+    Raises
+    ------
+    ModelError
+        When an edge force moves the contact point along the contact tangent or back into the
+        pusher (normal speed <= 0; power stays positive through the tangential part). Then no
+        twist of that edge has unit normal speed: the cone of contact velocities is not pointed
+        (it holds every push into the part, all of which stick). A contact on the line of a
+        two-point support, pushed along it, turns the part about a support point this way.
+    """
     geometry = _Geometry.of(surface, contact, normal, mu)
     twists = []
     for side in (1, -1):
         twist = geometry.unit_twist(geometry.edge(side))
-        normal_speed = _dot(geometry.normal, geometry.velocity_of(twist))
+        moved = geometry.velocity_of(twist)
+        normal_speed = _dot(geometry.normal, moved)
+        if not normal_speed > 0.0:
+            name = "left" if side > 0 else "right"
+            raise ModelError(
+                f"the {name} edge force of the pusher's friction cone at contact "
+                f"{list(geometry.contact)} moves the part with the twist "
+                f"{[float(x) for x in twist]}, whose contact velocity {[float(x) for x in moved]} "
+                f"has normal speed {normal_speed:.3g} along the normal {list(geometry.normal)}: "
+                "it does not move the part away from the pusher, so the motion cone has no edge "
+                "twist at unit normal speed (every push into the part sticks); use push_step "
+                "for a given pusher velocity"
+            )
         twists.append(np.array(_scaled(twist, 1.0 / normal_speed)))
     return MotionCone(left=twists[0], right=twists[1])
 

@@ -21,7 +21,9 @@ frame) then solves ``M a = L - λ`` with ``λ`` the friction of the motion that 
 
 .. math:: a^* = \arg\min_a \tfrac12 a^T M a - L \cdot a + h(a), \qquad M = \mathrm{diag}(m, m, I):
 
-``a* = 0`` exactly when ``L`` lies inside the limit surface (static friction holds), and
+``a* = 0`` exactly when ``L`` lies inside the limit surface (static friction holds; as in the
+friction models, a load whose safety factor is at least ``1 - CONTAINMENT_RTOL`` counts as held,
+so a load on the surface itself, such as a push of exactly ``mu N``, leaves the body at rest), and
 otherwise ``λ = L - M a*`` is the point of the limit surface nearest to ``L`` in the metric of
 ``M^{-1}`` (Moreau's decomposition), with the surface's normal there along ``a*`` (normality).
 It is solved as the root of its smooth gradient ``M a - L + ∇h(a)`` (Powell's hybrid method),
@@ -49,6 +51,7 @@ from scipy.optimize import brentq, root
 from fixplan import validation
 from fixplan.errors import ConvergenceError, InvalidArgumentError
 from fixplan.motion.forward_map import ForwardMap, forward_map
+from fixplan.tolerances import CONTAINMENT_RTOL
 
 #: The body counts as stopped when its speed (with rotation counted at the radius of gyration)
 #: falls below this fraction of the run's speed scale.
@@ -182,8 +185,9 @@ def slide(
             body.rate, (t, duration), state, t_eval=grid[grid > t], events=stopping,
             rtol=INTEGRATION_RTOL, atol=atol,
         )  # fmt: skip
-        times += list(result.t)
-        states += list(result.y.T)
+        # scipy returns lists, not arrays, when the run ends before the first sample.
+        times += list(np.asarray(result.t, dtype=float))
+        states += list(np.reshape(result.y, (len(state), -1)).T)
         if not result.t_events[0].size:
             break
         t = float(result.t_events[0][0])
@@ -248,11 +252,14 @@ class _Body:
         def margin(time: float) -> float:
             return float(self.friction.safety_factor(self.applied(time, pose))) - 1.0
 
-        if margin(t) < 0.0:
+        if margin(t) < -CONTAINMENT_RTOL:
             return t
         before = t
         for time in grid[grid > t]:
-            if margin(time) < 0.0:
+            if margin(time) < -CONTAINMENT_RTOL:
+                # It leaves where the load crosses the surface itself (held until then).
+                if margin(before) <= 0.0:
+                    return before
                 return brentq(margin, before, time, xtol=LEAVE_XTOL * grid[-1])
             before = time
         return None
@@ -273,7 +280,7 @@ def _start(friction: ForwardMap, masses: np.ndarray, load: np.ndarray) -> np.nda
     """``argmin 1/2 a^T M a - L·a + h(a)``, solved in ``b = M^{1/2} a`` (unit Hessian of the
     quadratic): the root of ``b - M^{-1/2} (L - ∇h(M^{-1/2} b))``."""
     safety = float(friction.safety_factor(load))
-    if safety >= 1.0:
+    if safety >= 1.0 - CONTAINMENT_RTOL:
         return np.zeros(3)
     root_masses = np.sqrt(masses)
     scaled = load / root_masses

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fixplan import validation
-from fixplan.errors import InvalidArgumentError, ModelError
+from fixplan.errors import GeometryError, InvalidArgumentError, ModelError
 from fixplan.motion.line_contact import line_push_step
 from fixplan.motion.outline import Outline
 from fixplan.motion.pushers import LinePusher, PointPusher
@@ -133,6 +133,7 @@ def push(
     if isinstance(steps, bool) or not isinstance(steps, int | np.integer) or steps < 1:
         raise InvalidArgumentError(f"steps must be a positive integer, got {steps!r}")
     pose = validation.finite_array("pose", pose, shape=(3,)).copy()
+    contact.check_start(pose)
     dt = duration / steps
     times, poses = [0.0], [pose.copy()]
     twists, modes, forces, points, counts = [], [], [], [], []
@@ -183,15 +184,32 @@ class _RoundContact:
         size = float(np.abs(shape.vertices).max()) if len(shape.vertices) else shape.radius
         self.tolerance = TOUCH_RTOL * max(size, pusher.radius)
 
+    def check_start(self, pose: np.ndarray) -> None:
+        """Refuse a pusher that starts inside the part (the push has no meaning then)."""
+        overlap = -self.gap(pose, 0.0)
+        if overlap > self.tolerance:
+            centre = self.pusher.position(0.0)
+            raise GeometryError(
+                f"the PointPusher of radius {self.pusher.radius:g} m starting at "
+                f"({centre[0]:g}, {centre[1]:g}) m overlaps the part at pose {tuple(pose.tolist())} by "
+                f"{overlap:.6g} m at t = 0: start it at least its radius outside the outline"
+            )
+
     def gap(self, pose: np.ndarray, t: float) -> float:
         """Distance between the pusher's surface and the outline at time ``t`` [m]."""
         return self.shape.nearest(_local(pose, self.pusher.position(t)))[2] - self.pusher.radius
 
     def state(self, pose: np.ndarray, t: float) -> _State:
-        point, outward, _ = self.shape.nearest(_local(pose, self.pusher.position(t)))
+        centre = _local(pose, self.pusher.position(t))
+        point, outward, gap = self.shape.nearest(centre)
         velocity = _rotation(pose[2]).T @ self.pusher.velocity(t)
-        step = push_step(self.surface, contact=point, normal=-outward, velocity=velocity,
-                         mu=self.pusher.mu)  # fmt: skip
+        if gap <= self.tolerance and not self.shape.enters(point, velocity):
+            # A point pusher on the outline that moves along it (at a corner: along or out of
+            # one of its edges) does not push; the corner's bisector would make it.
+            step = PushStep.separated()
+        else:
+            step = push_step(self.surface, contact=point, normal=-outward, velocity=velocity,
+                             mu=self.pusher.mu)  # fmt: skip
         bearing = point[None, :] if step.mode != "separated" else np.empty((0, 2))
         return _State(step, point[None, :], bearing, ())
 
@@ -218,6 +236,17 @@ class _FaceContact:
         normal = _rotation(pose[2]).T @ self.pusher.normal
         return self.shape.face_points(_local(pose, self.pusher.position(t)), normal,
                                       self.pusher.width / 2)  # fmt: skip
+
+    def check_start(self, pose: np.ndarray) -> None:
+        """Refuse a face that starts inside the part (the push has no meaning then)."""
+        overlap = -self.gap(pose, 0.0)
+        if overlap > self.tolerance:
+            centre = self.pusher.position(0.0)
+            raise GeometryError(
+                f"the LinePusher of width {self.pusher.width:g} m centred at "
+                f"({centre[0]:g}, {centre[1]:g}) m overlaps the part at pose {tuple(pose.tolist())} by "
+                f"{overlap:.6g} m along its normal at t = 0: start its face outside the outline"
+            )
 
     def gap(self, pose: np.ndarray, t: float) -> float:
         """Height of the outline's lowest point in the strip above the face [m] (inf: none)."""
