@@ -240,6 +240,14 @@ def test_a_vanishing_normal_force_of_the_support_is_refused_at_its_key_path(
     assert issue.key_path == key_path and f"below {smallest}" in str(error.value)
 
 
+def test_a_pusher_that_starts_inside_the_part_is_invalid_input_naming_the_file(tmp_path, capsys):
+    path = tmp_path / "inside.toml"
+    path.write_text(_mutated(_set("pusher.start", [0.0, 0.0])), encoding="utf-8")
+    assert main(["push", str(path)]) == EXIT_INVALID_INPUT
+    err = capsys.readouterr().err
+    assert f"{path}: pusher: the LinePusher" in err and "overlaps the part" in err
+
+
 def test_fixplan_check_validates_a_push_file_and_plan_points_to_push(capsys):
     file = str(PROBLEMS / "push-box-flat.toml")
     assert main(["check", file, "--json"]) == EXIT_OK

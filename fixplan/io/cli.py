@@ -24,7 +24,7 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 from fixplan import __version__
-from fixplan.errors import ConvergenceError, FixplanError, InvalidArgumentError
+from fixplan.errors import ConvergenceError, FixplanError, GeometryError, InvalidArgumentError
 
 # Only the standard library is imported up to here: ``fixplan --help`` and ``--version`` stay
 # fast (numpy, cvxpy and the planner are imported by the subcommands that use them).
@@ -761,11 +761,14 @@ def _run_push(args: argparse.Namespace) -> tuple[int, str]:
     if args.report is not None:
         _check_output_folder(args.report, "--report")
     log.info("pushing %s (%d steps)", args.file, push_file.steps)
-    trajectory = push(
-        push_file.surface, push_file.pusher, shape=push_file.shape, pose=push_file.pose,
-        duration=push_file.duration, steps=push_file.steps,
-        progress=_Progress("pushing", not args.quiet),
-    )  # fmt: skip
+    try:
+        trajectory = push(
+            push_file.surface, push_file.pusher, shape=push_file.shape, pose=push_file.pose,
+            duration=push_file.duration, steps=push_file.steps,
+            progress=_Progress("pushing", not args.quiet),
+        )  # fmt: skip
+    except GeometryError as exc:  # (a start the file's values allow one by one)
+        raise InvalidArgumentError(f"{args.file}: pusher: {exc}") from None
     if args.report is not None:
         written = write_push_report(args.report, push_file, trajectory)
         log.info("wrote %d report files to %s", len(written), args.report)
