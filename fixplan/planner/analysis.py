@@ -219,14 +219,14 @@ def summary(
     highest, lowest, use, cap, atol, held_rtol, k_max, k_min, held, utilisation
 ):  # pragma: no cover - compiled
     """The multiples of the two solves ``highest`` and ``lowest`` (empty: 0 for every case),
-    cleaned into ``k_max`` and ``k_min`` (solver noise below 0 and below ``atol``, from ``cap``
-    on as infinity, ``k_min`` above ``k_max`` as ``k_max``), the held cases into ``held`` and ``use`` ``(C, K)`` capped at 1 into
-    ``utilisation``. Returns the critical case (the first of those tied within ``held_rtol``
+    cleaned into ``k_max`` and ``k_min`` (solver noise below 0, below ``atol`` as 0, from
+    ``cap`` on as infinity, ``k_min`` above ``k_max`` as ``k_max``), the held cases into
+    ``held`` and ``use`` ``(C, K)`` capped at 1 into ``utilisation``. Returns the critical case (the first of those tied within ``held_rtol``
     with the smallest margin ``min(k_max, 1 / k_min)``) and its most used contact."""
     margins = np.empty(k_max.shape[0])
     for j in range(k_max.shape[0]):
         high = max(highest[j], 0.0)  # the solver may return -1e-19 for 0
-        k_max[j] = np.inf if high >= cap else high
+        k_max[j] = np.inf if high >= cap else 0.0 if high < atol else high
         low = max(lowest[j], 0.0) if lowest.shape[0] else 0.0
         # (Where the forces hold one multiple only, the two solves' noise may cross.)
         k_min[j] = 0.0 if low < atol else min(low, k_max[j])

@@ -70,7 +70,9 @@ class Verifier:
                         f"{ratio * size:.3g} {unit}, over {EQUILIBRIUM_RTOL:g} of the "
                         f"wrenches involved ({size:.3g} {unit})"
                     )
-        scale_force = max(largest, 1e-12)
+        # Against the largest normal force, or task force at multiple 1 (a multiple held near 0
+        # leaves every force tiny).
+        scale_force = max(largest, LARGEST_MAGNITUDE(wrenches[:3]), 1e-12)
         noise = FRICTION_SET_RTOL * scale_force
         use = self._use(friction, normal, noise=noise, known=answer.get("known_use"))
         if _TROUBLED(normal, use, noise):
@@ -108,8 +110,8 @@ class Verifier:
 def equilibrium(normal_map, friction_map, normal, friction, wrenches, scale, gravity,
                 length_scale, sizes, ratios):  # fmt: skip  # pragma: no cover - compiled
     """Each case's largest residual of force and of moment (rows of ``ratios`` ``(2, K)``)
-    over the size of its wrench terms (``sizes``: the largest force and moment of any term,
-    moments at least force × ``length_scale``); returns the largest ratio (0 for no case) and
+    over the size of its wrench terms and its task load at multiple 1 (``sizes``: the largest
+    force and moment of any term, moments at least force × ``length_scale``); returns the largest ratio (0 for no case) and
     the largest magnitude of ``normal`` (see :func:`largest_magnitude`). A row with a term that
     is not finite (NaN or infinite) has an infinite residual."""
     largest = 0.0
@@ -119,7 +121,8 @@ def equilibrium(normal_map, friction_map, normal, friction, wrenches, scale, gra
         for row in range(6):
             task = wrenches[row, k] * scale[k]
             total = task + gravity[row]
-            size = abs(task) + abs(gravity[row])
+            # (The task load at multiple 1 too: a multiple held near 0 leaves every term tiny.)
+            size = abs(task) + abs(gravity[row]) + abs(wrenches[row, k])
             for c in range(normal.shape[0]):
                 term = normal_map[row, c] * normal[c, k]
                 total += term
