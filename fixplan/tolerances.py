@@ -198,6 +198,11 @@ MAX_ANNULUS_RATIO = 0.999
 #: 1e-11, 8e-11 at 1e-12, and from 1e-14 the inverse map fails (3 to 400 loads in 1,000).
 MIN_WEIGHT_RATIO = 1e-10
 
+#: Largest weight of the twists against the loads in a fit of measured pairs: on 200 noisy
+#: pairs of an ellipsoid both fits solved up to 1e6 and failed at 1e8 (an indefinite ellipsoid,
+#: an inaccurate quartic); the twist term dominates long before (keep it near 1).
+MAX_FIT_WEIGHT = 1e4
+
 #: Largest speed of a pusher [m/s].
 MAX_SPEED = 1e3
 

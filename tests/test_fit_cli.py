@@ -362,8 +362,12 @@ def test_data_the_fit_cannot_use_names_the_file(tmp_path, capsys):
     [
         (["--holdout", "1"], "--holdout must be a fraction in [0, 1), got 1"),
         (["--holdout", "nan"], "--holdout must be a fraction in [0, 1)"),
-        (["--weight", "-1"], "--weight must be a number >= 0, got -1"),
-        (["--weight", "inf"], "--weight must be a number >= 0, got inf"),
+        (["--weight", "-1"], "--weight must be a number from 0 to 10000 (keep it near 1), got -1"),
+        (
+            ["--weight", "inf"],
+            "--weight must be a number from 0 to 10000 (keep it near 1), got inf",
+        ),
+        (["--weight", "1e300"], "--weight must be a number from 0 to 10000"),
         (["--normal-force", "3"], "has a normal_force column already; drop one of them"),
         (["--save", "no-such-folder/fit.json"], "--save no-such-folder/fit.json: the folder"),
     ],

@@ -784,12 +784,15 @@ def _run_push(args: argparse.Namespace) -> tuple[int, str]:
 
 def _fit_options(args: argparse.Namespace) -> dict:
     """The keyword arguments of :func:`fixplan.motion.fit` given on the command line."""
-    from fixplan.tolerances import MAX_FORCE
+    from fixplan.tolerances import MAX_FIT_WEIGHT, MAX_FORCE
 
     options = {"model": args.model}
     if args.weight is not None:
-        if not (math.isfinite(args.weight) and args.weight >= 0.0):
-            raise InvalidArgumentError(f"--weight must be a number >= 0, got {args.weight:g}")
+        if not 0.0 <= args.weight <= MAX_FIT_WEIGHT:
+            raise InvalidArgumentError(
+                f"--weight must be a number from 0 to {MAX_FIT_WEIGHT:g} (keep it near 1), got "
+                f"{args.weight:g}"
+            )
         options["weight"] = args.weight
     if args.holdout is not None:
         if not 0.0 <= args.holdout < 1.0:

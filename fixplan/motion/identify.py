@@ -55,6 +55,7 @@ from fixplan.motion.fitted_quartic import (
 )
 from fixplan.motion.forward_map import forward_map
 from fixplan.surface.limit_surface import LimitSurface
+from fixplan.tolerances import MAX_FIT_WEIGHT
 
 #: Default weight ``λ`` of the coefficient norm, with the data scaled to unit median radius. It
 #: only keeps the problem bounded when the data leave a direction free; at 0.1 (Zhou's value,
@@ -129,6 +130,11 @@ def fit(
     loads, twists = measured_pairs(loads, twists)
     normal_force = validation.positive_scalar("normal_force", normal_force)
     weight = validation.nonnegative_scalar("weight", weight)
+    if weight > MAX_FIT_WEIGHT:
+        raise InvalidArgumentError(
+            f"weight must be at most {MAX_FIT_WEIGHT:g} (the twists against the loads; keep it "
+            f"near 1), got {weight!r}"
+        )
     regularization = validation.nonnegative_scalar("regularization", regularization)
     holdout = validation.nonnegative_scalar("holdout", holdout)
     if holdout >= 1.0:
