@@ -471,6 +471,16 @@ def _inputs():
             InvalidArgumentError,
             ["2e-08 m by 0.02 m", "above 100000"],
         ),
+        "points closer than 1e-7 of their span": (
+            lambda: pressure.points([[0, 0], [1e-12, 0], [0.01, 0], [0, 0.01]]),
+            GeometryError,
+            ["xy", "1e-12 m apart", "one point"],
+        ),
+        "points spanning less than a nanometre": (
+            lambda: pressure.points([[0, 0], [1e-300, 0]]),
+            GeometryError,
+            ["xy", "span 1e-300 m", "at least 1e-09 m"],
+        ),
         "grid values of the wrong shape": (
             lambda: pressure.grid([0, 1], [0, 1], np.ones((3, 2))),
             InvalidArgumentError,

@@ -39,6 +39,7 @@ from fixplan.tolerances import (
     MAX_ANNULUS_RATIO,
     MAX_ASPECT_RATIO,
     MIN_PATCH_LENGTH,
+    MIN_POINT_GAP_RATIO,
     MIN_WEIGHT_RATIO,
 )
 
@@ -367,6 +368,12 @@ def points(xy, weights=None, *, centered: bool = True) -> PointsField:
             "points needs at least two distinct loaded points; a single point has no torsional "
             "friction (use a point-contact model for it)"
         )
+    if span < MIN_PATCH_LENGTH:
+        raise GeometryError(
+            f"xy: the loaded points span {span!r} m; at least {MIN_PATCH_LENGTH:g} m (below it "
+            "the limit surface's arithmetic underflows): use a point-contact model"
+        )
+    _check_separation(xy_array, span)
     if centered:
         xy_array = xy_array - w @ xy_array
     xy_array = np.array(xy_array)
@@ -382,6 +389,22 @@ def measurable(weights) -> np.ndarray:
     weights = np.array(weights, dtype=float)
     weights[weights < MIN_WEIGHT_RATIO * weights.max(initial=0.0)] = 0.0
     return weights
+
+
+def _check_separation(xy: np.ndarray, span: float) -> None:
+    """Raise where two distinct points ``xy`` ``(n, 2)`` [m] lie closer than
+    ``MIN_POINT_GAP_RATIO`` of their ``span`` [m]."""
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(xy).query_pairs(MIN_POINT_GAP_RATIO * span, output_type="ndarray")
+    if len(pairs):
+        i, j = pairs[0]
+        gap = float(np.hypot(*(xy[i] - xy[j])))
+        raise GeometryError(
+            f"xy: points {xy[i].tolist()} and {xy[j].tolist()} are {gap!r} m apart, closer than "
+            f"{MIN_POINT_GAP_RATIO:g} of the points' span ({span!r} m): the inverse map cannot "
+            "tell them apart. Give them as one point (the sum of their weights) or farther apart"
+        )
 
 
 def check_weight_ratio(name: str, weights: np.ndarray) -> None:
