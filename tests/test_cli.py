@@ -375,6 +375,9 @@ def test_solver_output_on_file_descriptor_1_goes_to_stderr(tmp_path, capfd, monk
     [
         (["--radius", "1e308"], "--radius must be at most 1000 m"),
         (["--radius", "0.01", "--plot", "missing/figure.png"], "the folder"),
+        (["--radius", "0.01", "--length", "0.02"], "--length is not an option of --shape disk"),
+        (["--radius", "0.01", "--inner-radius", "0.005"], "(only of --pressure annulus)"),
+        (["--radius", "0.01", "--normal-force", "1e-200"], "normal_force = 1e-200 N is below"),
     ],
 )
 def test_surface_options_out_of_range_are_invalid_input(tmp_path, capsys, monkeypatch, options,

@@ -1100,11 +1100,21 @@ def _patch(args: argparse.Namespace):
             f"--mu must be at least {MIN_MU:g} (friction that small is rounding noise), got "
             f"{args.mu:g}"
         )
+    # Options of the other shape (or profile) are refused, as a problem file's keys are.
+    unused = {"disk": ("length", "width"), "rectangle": ("radius", "inner_radius")}[args.shape]
+    if args.shape == "disk" and args.pressure != "annulus":
+        unused += ("inner_radius",)
+    for option in unused:
+        if getattr(args, option) is not None:
+            of = "--pressure annulus" if option == "inner_radius" and args.shape == "disk" else ""
+            raise InvalidArgumentError(
+                f"--{option.replace('_', '-')} is not an option of --shape {args.shape}"
+                + (f" --pressure {args.pressure} (only of {of})" if of else "")
+            )
     if args.shape == "disk":
         if args.radius is None:
             raise InvalidArgumentError("--shape disk needs --radius [m]")
-        inner = args.inner_radius if args.pressure == "annulus" else None
-        return pressure.disk(args.radius, args.pressure, inner_radius=inner)
+        return pressure.disk(args.radius, args.pressure, inner_radius=args.inner_radius)
     if args.length is None or args.width is None:
         raise InvalidArgumentError("--shape rectangle needs --length and --width [m]")
     if args.pressure != "uniform":
