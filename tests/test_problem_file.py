@@ -495,9 +495,19 @@ def test_a_fixed_force_above_max_force_is_reported_at_the_contact(tmp_path):
     _assert_issue(_issues(tmp_path, text), "contacts[1]", "exceeds max_force 2000.0")
 
 
-def test_an_objective_the_contacts_cannot_meet_is_reported_at_the_objective(tmp_path):
+def test_an_objective_the_contacts_cannot_meet_is_reported_at_the_contacts(tmp_path):
+    # (At the objective before: the force to give is the contact's.)
     text = _edited(VALID, ('objective = "min-total-clamp-force"', 'objective = "check"'))
-    _assert_issue(_issues(tmp_path, text), "objective", "contact 'jaw-moving'.force is required")
+    _assert_issue(_issues(tmp_path, text), "contacts[1].force",
+                  "required: objective 'check' takes the active forces as given")  # fmt: skip
+
+
+def test_a_turning_load_without_the_bodys_inertia_is_reported_at_the_body(tmp_path):
+    text = _edited(VALID, ("point = [0.03, 0.0, 0.04]",
+                           "point = [0.03, 0.0, 0.04]\nangular_velocity = [0, 0, 1]"))  # fmt: skip
+    _assert_issue(
+        _issues(tmp_path, text), "body", "load 'face-mill-pass-1' (loads[0]) has an angular"
+    )
 
 
 def test_all_mistakes_of_a_file_are_reported_at_once(tmp_path):
@@ -684,7 +694,8 @@ def test_check_compliant_names_the_contacts_without_stiffness(tmp_path):
 
 def test_check_compliant_takes_the_active_forces_as_given(tmp_path):
     text = _with_stiffness(COMPLIANT)
-    _assert_issue(_issues(tmp_path, text), "objective", "contact 'jaw-moving'.force is required")
+    _assert_issue(_issues(tmp_path, text), "contacts[1].force",
+                  "required: objective 'check-compliant' takes the active forces")  # fmt: skip
 
 
 def test_an_invalid_default_stiffness_is_reported_once(tmp_path):

@@ -152,6 +152,7 @@ from fixplan.planner.mesh_body import surface_contact
 from fixplan.planner.problem import (
     AREA_MODEL_NAMES,
     COMPLIANT_OBJECTIVE,
+    FIXED_FORCE_OBJECTIVES,
     MODEL_NAMES,
     OBJECTIVES,
     PASSIVE_ROLES,
@@ -532,6 +533,9 @@ class _Reader:
         check_unique_names(load_tables, "load")
         if self.issues:
             return name, kind, None
+        self._demands(objective, body_table, body, contact_tables, contacts, load_tables, loads)
+        if self.issues:
+            return name, kind, None
         # Only the objective's demands on the contacts are left for Problem to find.
         problem = build(
             top,
@@ -543,6 +547,30 @@ class _Reader:
             objective=objective,
         )
         return name, kind, problem
+
+    def _demands(self, objective, body_table, body, contact_tables, contacts, load_tables, loads):
+        """The demands one table makes of another, each reported where it is to be met: the
+        given forces of a fixed-force objective (at each contact), the body's inertia of a
+        turning load (at the body), names of candidates the contacts use (at the candidate)."""
+        if objective in FIXED_FORCE_OBJECTIVES:
+            for table, contact in zip(contact_tables, contacts, strict=False):
+                if contact.is_active and contact.force is None:
+                    table.report("force", f"required: objective {objective!r} takes the "
+                                          "active forces as given (or give a force "
+                                          "objective)")  # fmt: skip
+        if body is not None and body.inertia is None:
+            for table, load in zip(load_tables, loads, strict=True):
+                if load.rotates:
+                    body_table.report(None, f"load {load.name!r} ({table.path}) has an angular "
+                                            "velocity or acceleration: the body needs an inertia "
+                                            "tensor (inertia, size or a mesh)")  # fmt: skip
+                    break
+        names = {c.name: table.path for table, c in zip(contact_tables, contacts, strict=False)}
+        for candidate in self.candidates if self.layout else ():
+            if candidate.name in names:
+                self.issues.append(Issue(key_path=names[candidate.name] + ".name",
+                                         message=f"contact name {candidate.name!r} is also a "
+                                                 "candidate's"))  # fmt: skip
 
     def _candidates(self, top: Table, defaults: _Defaults, body: Body | None) -> list[Contact]:
         """A layout file's candidates, those of ``sample`` tables spread over the mesh."""
