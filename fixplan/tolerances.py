@@ -173,7 +173,7 @@ MAX_RELATIVE_VALUE = 1e12
 #: underflows.
 MIN_PATCH_LENGTH = 1e-9
 
-#: Smallest normal force and largest friction force ``mu N`` [N] of a limit surface: the
+#: Smallest normal force and smallest largest-friction-force ``mu N`` [N] of a limit surface: the
 #: inverse map squares loads of that size (at 1e-200 N its safety factors came out NaN, at
 #: 1e-150 N right).
 MIN_FRICTION_FORCE = 1e-100

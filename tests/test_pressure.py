@@ -547,5 +547,6 @@ def test_measurable_weights_drop_an_engines_rim_that_points_refuses():
     with pytest.raises(InvalidArgumentError, match="below 1e-10 of the largest"):
         pressure.points(xy, weights)
     np.testing.assert_array_equal(pressure.measurable(weights), [1.0, 0.0, 1e-10])
+    np.testing.assert_array_equal(pressure.measurable([1.0, -1e-20]), [1.0, -1e-20])  # refused
     field = pressure.points(xy, pressure.measurable(weights), centered=False)
     np.testing.assert_allclose(field.xy, [[0, 0], [0, 0.01]])

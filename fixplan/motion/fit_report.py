@@ -190,8 +190,8 @@ def _rows(name: str, value) -> np.ndarray:
 
 def measured_pairs(loads, twists) -> tuple[np.ndarray, np.ndarray | None]:
     """Loads and (optional) twists as :func:`_rows`, of the same shape; each twist divided by
-    its largest entry (only their directions matter, and their squares stay finite at any
-    size)."""
+    its largest absolute entry (only their directions matter, and their squares stay finite at
+    any size)."""
     loads = _rows("loads", loads)
     if twists is None:
         return loads, None

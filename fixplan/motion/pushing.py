@@ -164,7 +164,8 @@ def push_step(surface, *, contact, normal, velocity, mu: float) -> PushStep:
     load = geometry.load_of(force)
     twist, scale = geometry.twist_and_scale(load)
     normal_speed = _dot(geometry.normal, geometry.velocity_of(twist))
-    if normal_speed <= 0.0:  # pragma: no cover - normality makes it positive
+    # (An edge whose twist does not push the part away makes every push stick: not reached.)
+    if normal_speed <= 0.0:  # pragma: no cover
         raise ModelError("the edge force does not drive the part away from the pusher")
     twist = _scaled(twist, push / normal_speed)
     moved = geometry.velocity_of(twist)

@@ -253,10 +253,10 @@ def _integrate(body, span, state, samples, stopping, atol):
             continue
     raise ConvergenceError(
         f"slide: the motion from t = {span[0]:.6g} s took more than {MAX_EVALUATIONS:,} "
-        "evaluations of its equations with an explicit and with an implicit method: it keeps "
-        "switching between two frictions, as a part on point supports that pivots about one of "
-        "them does (the friction of that point flips at every step); such pivots are not "
-        "modelled yet. Support the part on a patch, or shorten the duration to before the pivot"
+        "evaluations of its equations with RK45 and with LSODA: its friction switches faster "
+        "than either can follow, as for a part on point supports that pivots about one of "
+        "them (the friction of that point flips at every step), which is not modelled yet. "
+        "Support the part on a patch, or shorten the duration to before the pivot"
     )
 
 

@@ -220,7 +220,7 @@ def summary(
 ):  # pragma: no cover - compiled
     """The multiples of the two solves ``highest`` and ``lowest`` (empty: 0 for every case),
     cleaned into ``k_max`` and ``k_min`` (solver noise below 0, below ``atol`` as 0, from
-    ``cap`` on as infinity, ``k_min`` above ``k_max`` as ``k_max``), the held cases into
+    ``cap`` on as infinity, ``k_min`` above ``k_max`` by less than ``held_rtol`` as ``k_max``), the held cases into
     ``held`` and ``use`` ``(C, K)`` capped at 1 into ``utilisation``. Returns the critical case (the first of those tied within ``held_rtol``
     with the smallest margin ``min(k_max, 1 / k_min)``) and its most used contact."""
     margins = np.empty(k_max.shape[0])
@@ -228,8 +228,10 @@ def summary(
         high = max(highest[j], 0.0)  # the solver may return -1e-19 for 0
         k_max[j] = np.inf if high >= cap else 0.0 if high < atol else high
         low = max(lowest[j], 0.0) if lowest.shape[0] else 0.0
+        k_min[j] = 0.0 if low < atol else low
         # (Where the forces hold one multiple only, the two solves' noise may cross.)
-        k_min[j] = 0.0 if low < atol else min(low, k_max[j])
+        if k_max[j] < k_min[j] <= k_max[j] + held_rtol * max(1.0, k_min[j]):
+            k_min[j] = k_max[j]
         margins[j] = min(k_max[j], 1.0 / k_min[j] if k_min[j] > 0.0 else np.inf)
         held[j] = k_min[j] <= 1.0 + held_rtol and k_max[j] >= 1.0 - held_rtol
     for c in range(use.shape[0]):

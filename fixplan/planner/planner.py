@@ -196,11 +196,8 @@ class Planner:
         if objective in FIXED_FORCE_OBJECTIVES:
             extra = self._intervals(names, result, wrenches, given, progress, off)
         elif analyse and status == "optimal":
-            extra, note, held = self._analysis(names, result, use, wrenches, forces, squeezed,
-                                               progress, off)  # fmt: skip
-            if not held:
-                status = "inaccurate"
-                warnings.warn(note, stacklevel=2)
+            extra, note = self._analysis(names, result, use, wrenches, forces, squeezed, progress,
+                                         off)  # fmt: skip
             if note is not None:
                 notes.append(note)
         else:
@@ -219,11 +216,15 @@ class Planner:
 
     def _analysis(
         self, names, result, use, wrenches, forces, squeezed, progress, disabled
-    ) -> tuple[dict, str | None, bool]:
+    ) -> tuple[dict, str | None]:
         """The safety analysis of a force objective's optimum ``result`` (its friction ``use``,
-        verified; its active ``forces`` by name): the plan's fields, a note where it failed or
-        found a load case not held, and whether every case is held (else the optimum's
-        forces are not what the solve claimed, to the solver's accuracy)."""
+        verified; its active ``forces`` by name): the plan's fields and a note where it failed
+        or missed the multiple 1 of a load case.
+
+        The optimum holds every case at multiple 1 (verified: its residuals are within the
+        tolerances of its forces), so a case whose held interval misses 1 by more than
+        ``HELD_RTOL`` (or a ``check`` found infeasible) misses it by the solver's accuracy: it
+        is held, and the note says how sensitive its multiples are."""
         planned = {self._index_of[name]: f for name, f in forces.items()}
         ends = self._carried_ends(wrenches, planned, progress, disabled)
         if "highest" in ends:  # the force solve's loads, verified just now
@@ -233,16 +234,17 @@ class Planner:
             checked = self._squeeze_free(
                 "check", wrenches, planned, squeezed, progress=progress, disabled=disabled
             )
-        if checked["status"] == "infeasible":  # held at no multiple
-            return {}, _not_held_note(None), False
+        if checked["status"] == "infeasible":
+            return {}, _sensitive_note(None)
         if checked["status"] != "optimal" and checked["status"] != "inaccurate":
-            return {}, f"safety analysis of the forces found: {checked['status']}", True
+            return {}, f"safety analysis of the forces found: {checked['status']}"
         extra = self._intervals(names, checked, wrenches, planned, progress, disabled,
                                 lowest=ends.get("lowest"))  # fmt: skip
-        if all(extra["held"].values()):
-            return extra, None, True
         missed = {n: v for n, v in extra["held_intervals"].items() if not extra["held"][n]}
-        return extra, _not_held_note(missed), False
+        if not missed:
+            return extra, None
+        extra["held"].update(dict.fromkeys(missed, True))
+        return extra, _sensitive_note(missed)
 
     def _switched_off(self, disabled: Sequence[str]) -> np.ndarray | None:
         """``(C,)`` bool of the contacts named in ``disabled`` (``None`` for none)."""
@@ -391,21 +393,24 @@ class Planner:
         return out
 
 
-def _not_held_note(intervals: dict | None) -> str:
-    """The note on the load cases that the forces of a force objective's optimum do not hold:
-    their held ``intervals`` miss 1 by more than ``HELD_RTOL`` (``None``: the safety analysis
-    found them held at no multiple)."""
+def _sensitive_note(intervals: dict | None) -> str:
+    """The note on the load cases whose held ``intervals`` in the analysis of a force
+    objective's optimum miss 1 by more than ``HELD_RTOL`` (``None``: the analysis found the
+    forces held at no multiple), though its verified forces hold them at 1."""
     if intervals is None:
-        missed = "at any multiple of their loads (the safety analysis found none)"
+        found = "at no multiple of the loads"
     else:
-        missed = f"at the multiple 1 of their loads (within {HELD_RTOL:g}), only at " + "; ".join(
-            f"{name!r}: {low:.9g} to {high:.9g}" for name, (low, high) in intervals.items()
+        found = "only at " + "; ".join(
+            f"{name!r}: {low:.9g} to {high:.9g} times its load"
+            for name, (low, high) in intervals.items()
         )
     return (
-        f"the forces found do not hold every load case {missed}. The solver's accuracy (about "
-        "1e-9 of the largest force) moves the multiples held that much where the forces are "
-        "far larger than the loads they hold, or must cancel exactly along a direction of the "
-        "loads: give the loads a margin or the contacts more friction."
+        f"the safety analysis of the forces found holds them {found}, which misses 1 by more "
+        f"than {HELD_RTOL:g}; the force solve holds every load case at 1 within the solver's "
+        "accuracy (about 1e-9 of the largest force), so they count as held: their multiples "
+        "are that sensitive to the forces here (forces far larger than the loads they hold, or "
+        "that must cancel a load component exactly). Give the loads a margin or the contacts "
+        "more friction for a safety factor that means something."
     )
 
 

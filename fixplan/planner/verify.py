@@ -44,12 +44,12 @@ class Verifier:
     def __call__(self, answer: dict, wrenches: np.ndarray) -> tuple[float, list[str], np.ndarray]:
         """The largest relative equilibrium residual of ``answer``, what failed, in words, and
         the friction use ``(C, K)`` of its loads (:class:`~fixplan.planner.friction_use.
-        FrictionUse`, with the noise of the largest normal force, as the analysis takes it).
+        FrictionUse`, with the noise of the largest normal force or task force).
 
         ``answer`` holds ``normal`` ``(C, K)`` [N], ``friction`` ``(D, K)`` and ``scale``
         ``(K,)``; ``wrenches`` ``(6, K)`` are the task wrenches. Forces are compared with the
         forces of each case's wrench terms and moments with their moments; a contact's friction
-        may exceed its set by ``FRICTION_SET_RTOL`` of the largest normal force.
+        may exceed its set by ``FRICTION_SET_RTOL`` of the largest normal force or task force.
         """
         normal, friction, scale = answer["normal"], answer["friction"], answer["scale"]
         sizes = np.empty((2, normal.shape[1]))
@@ -70,8 +70,8 @@ class Verifier:
                         f"{ratio * size:.3g} {unit}, over {EQUILIBRIUM_RTOL:g} of the "
                         f"wrenches involved ({size:.3g} {unit})"
                     )
-        # Against the largest normal force, or task force at multiple 1 (a multiple held near 0
-        # leaves every force tiny).
+        # Against the largest normal force, or task force at multiple 1 (the solver's accuracy is
+        # relative to its largest data; a multiple near 0 leaves every force tiny).
         scale_force = max(largest, LARGEST_MAGNITUDE(wrenches[:3]), 1e-12)
         noise = FRICTION_SET_RTOL * scale_force
         use = self._use(friction, normal, noise=noise, known=answer.get("known_use"))
@@ -82,7 +82,7 @@ class Verifier:
     def _friction_problems(self, normal, use, noise, scale_force) -> list[str]:
         """Pulling contacts, friction without normal force and friction outside its set, at
         the uses ``use`` ``(C, K)`` of the loads, in words (``noise`` [N]: the solver's, and
-        ``scale_force`` [N]: the largest normal force)."""
+        ``scale_force`` [N]: the largest normal force or task force)."""
         problems = [
             f"contact {self._names[i]!r} pulls: normal force {normal[i].min():.3g} N"
             for i in np.flatnonzero((normal < -noise).any(axis=1))
@@ -102,7 +102,7 @@ class Verifier:
             problems.append(
                 f"contact {self._names[i]!r} exceeds its friction set by "
                 f"{excess[i, worst]:.3g} N (over {FRICTION_SET_RTOL:g} of the largest normal "
-                f"force, {scale_force:.3g} N)"
+                f"force or task force, {scale_force:.3g} N)"
             )
         return problems
 
@@ -121,8 +121,8 @@ def equilibrium(normal_map, friction_map, normal, friction, wrenches, scale, gra
         for row in range(6):
             task = wrenches[row, k] * scale[k]
             total = task + gravity[row]
-            # (The task load at multiple 1 too: a multiple held near 0 leaves every term tiny.)
-            size = abs(task) + abs(gravity[row]) + abs(wrenches[row, k])
+            # (The task load at multiple 1 at least: a multiple near 0 leaves every term tiny.)
+            size = abs(wrenches[row, k]) * max(abs(scale[k]), 1.0) + abs(gravity[row])
             for c in range(normal.shape[0]):
                 term = normal_map[row, c] * normal[c, k]
                 total += term

@@ -126,10 +126,10 @@ class LimitSurface:
         if normal_force < MIN_FRICTION_FORCE or 0.0 < scale < MIN_FRICTION_FORCE:
             small = normal_force < MIN_FRICTION_FORCE
             what, value = ("normal_force", normal_force) if small else ("mu * normal_force", scale)
+            hint = "" if small else " (give mu = 0 for a frictionless contact)"
             raise InvalidArgumentError(
-                f"{what} = {value!r} N is below {MIN_FRICTION_FORCE:g} N, "
-                "where the surface's arithmetic underflows (give mu = 0 for a frictionless "
-                "contact)"
+                f"{what} = {value!r} N is below {MIN_FRICTION_FORCE:g} N, where the surface's "
+                f"arithmetic underflows{hint}"
             )
         self.field = field
         self._mu = mu

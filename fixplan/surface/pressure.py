@@ -383,11 +383,12 @@ def points(xy, weights=None, *, centered: bool = True) -> PointsField:
 
 
 def measurable(weights) -> np.ndarray:
-    """``weights`` with those below ``MIN_WEIGHT_RATIO`` of the largest set to 0: the rims of a
+    """``weights`` with the positive ones below ``MIN_WEIGHT_RATIO`` of the largest set to 0
+    (negative ones are left for :func:`points` to refuse): the rims of a
     field measured by a sensor or computed by an engine (forces of 1e-15 of the peak), which
     :func:`points` refuses."""
     weights = np.array(weights, dtype=float)
-    weights[weights < MIN_WEIGHT_RATIO * weights.max(initial=0.0)] = 0.0
+    weights[(weights > 0.0) & (weights < MIN_WEIGHT_RATIO * weights.max(initial=0.0))] = 0.0
     return weights
 
 
