@@ -10,11 +10,13 @@ from pathlib import Path
 import pytest
 
 from fixplan import __version__
+from fixplan.errors import ConvergenceError
 from fixplan.io import cli as cli_module
 from fixplan.io.cli import (
     EXIT_INVALID_INPUT,
     EXIT_NOT_HELD,
     EXIT_OK,
+    EXIT_SOLVER,
     main,
 )
 
@@ -433,3 +435,22 @@ def test_every_subcommand_example_names_a_problem_file_that_exists():
         for word in example[2:]:
             if word.startswith("problems/"):
                 assert (root / word).is_file(), f"{name}: {word}"
+
+
+def test_every_command_with_json_prints_a_document_when_it_fails(tmp_path, capsys, monkeypatch):
+    """A script reading ``--json`` gets one document on stdout whatever happens (it got
+    nothing but the message on stderr before): invalid input, a numerical failure."""
+    path = write(tmp_path)
+    path.write_text(path.read_text().replace("mu = 0.8", "mu = -1"))
+    assert main(["plan", str(path), "--json"]) == EXIT_INVALID_INPUT
+    out, err = capsys.readouterr()
+    assert json.loads(out) == {"error": "invalid input", "exit_code": EXIT_INVALID_INPUT,
+                               "message": err.removeprefix("fixplan: error: ").strip()}  # fmt: skip
+
+    def fails(*args, **kwargs):
+        raise ConvergenceError("the inverse map did not converge")
+
+    monkeypatch.setattr("fixplan.planner.planner.Planner.solve", fails)
+    assert main(["plan", str(write(tmp_path)), "--json"]) == EXIT_SOLVER
+    document = json.loads(capsys.readouterr().out)
+    assert document["error"] == "numerical failure" and "did not converge" in document["message"]

@@ -608,11 +608,9 @@ def _planned(args):
     if plan.status == "optimal":
         return problem_file, plan, None
     code = EXIT_NOT_HELD if plan.status == "infeasible" else EXIT_SOLVER
-    return (
-        problem_file,
-        plan,
-        (code, f"{args.file}: the plan is {plan.status}: no forces to simulate"),
-    )
+    message = f"{args.file}: the plan is {plan.status}: no forces to simulate"
+    document = {"file": str(args.file), "status": plan.status, "message": message}
+    return problem_file, plan, (code, _json(document) if args.json else message)
 
 
 def _run_export(args: argparse.Namespace) -> tuple[int, str]:
@@ -1305,29 +1303,36 @@ def main(argv: Sequence[str] | None = None) -> int:
             with np.errstate(all="ignore"):
                 code, output = args.run(args)
     except ConvergenceError as exc:
-        print(f"fixplan: numerical failure: {exc}", file=sys.stderr)
-        return EXIT_SOLVER
+        return _failed(args, "numerical failure", str(exc), EXIT_SOLVER)
     except FixplanError as exc:
-        print(f"fixplan: error: {exc}", file=sys.stderr)
         # Errors about the input, the outputs asked for (a folder that cannot be written) or an
         # extra they need derive from ValueError, OSError or ImportError; any other is fixplan's
         # own failure.
         invalid = isinstance(exc, ValueError | OSError | ImportError)
-        return EXIT_INVALID_INPUT if invalid else EXIT_UNEXPECTED
+        return _failed(args, "error", str(exc), EXIT_INVALID_INPUT if invalid else EXIT_UNEXPECTED)
     except KeyboardInterrupt:  # pragma: no cover
         return EXIT_UNEXPECTED
     except Exception as exc:
         log.debug("unexpected error", exc_info=True)
-        print(
-            f"fixplan: unexpected error: {type(exc).__name__}: {exc} (run with -v for details)",
-            file=sys.stderr,
-        )
-        return EXIT_UNEXPECTED
+        message = f"{type(exc).__name__}: {exc} (run with -v for details)"
+        return _failed(args, "unexpected error", message, EXIT_UNEXPECTED)
     try:
         print(output, flush=True)
     except BrokenPipeError:
         # The reader of stdout left early (``fixplan plan FILE | head``): drop the rest quietly.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    return code
+
+
+def _failed(args: argparse.Namespace, kind: str, message: str, code: int) -> int:
+    """Say why a command failed (on stderr; with ``--json`` also as a document on stdout, for
+    the scripts that read it) and return its exit ``code``."""
+    print(f"fixplan: {kind}: {message}", file=sys.stderr)
+    if getattr(args, "json", False):
+        what = {EXIT_INVALID_INPUT: "invalid input", EXIT_SOLVER: "numerical failure"}
+        document = {"error": what.get(code, "unexpected error"), "message": message,
+                    "exit_code": code}  # fmt: skip
+        print(_json(document), flush=True)
     return code
 
 
