@@ -461,6 +461,16 @@ def _inputs():
             InvalidArgumentError,
             ["x", "at least two"],
         ),
+        "disk below a nanometre": (
+            lambda: pressure.disk(1e-300),
+            InvalidArgumentError,
+            ["radius", "at least 1e-09 m", "1e-300"],
+        ),
+        "polygon below a nanometre": (
+            lambda: pressure.polygon([[0, 0], [1e-12, 0], [0, 1e-12]]),
+            InvalidArgumentError,
+            ["vertices' extent", "at least 1e-09 m"],
+        ),
         "grid cells below a nanometre": (
             lambda: pressure.grid([0, 1e-11], [0, 0.01], np.ones((2, 2))),
             InvalidArgumentError,

@@ -1062,7 +1062,8 @@ def _checked_push(args: argparse.Namespace, push_file) -> str:
 def _bounded(option: str, value: float | None, limit: float, unit: str) -> None:
     """Reject an option value above ``limit`` (the range the library accepts is checked by it)."""
     if value is not None and math.isfinite(value) and abs(value) > limit:
-        raise InvalidArgumentError(f"{option} must be at most {limit:g} {unit}, got {value:g}")
+        raise InvalidArgumentError(f"{option} must be at most {f'{limit:g} {unit}'.strip()}, "
+                                   f"got {value:g}")  # fmt: skip
 
 
 def _patch(args: argparse.Namespace):

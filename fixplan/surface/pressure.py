@@ -286,7 +286,7 @@ def disk(
     ``inner_radius`` [m] (``0 < inner_radius <= MAX_ANNULUS_RATIO * radius``) is required by,
     and only allowed with, ``profile="annulus"``.
     """
-    radius = validation.positive_scalar("radius", radius)
+    radius = _patch_length("radius", radius)
     profile = validation.choice("profile", profile, DISK_PROFILES)
     if profile == "annulus":
         if inner_radius is None:
@@ -309,10 +309,21 @@ def disk(
     return DiskField(radius_m=radius, profile=profile)
 
 
+def _patch_length(name: str, value) -> float:
+    """``value`` [m] as a float of at least ``MIN_PATCH_LENGTH``."""
+    length = validation.positive_scalar(name, value)
+    if length < MIN_PATCH_LENGTH:
+        raise InvalidArgumentError(
+            f"{name} must be at least {MIN_PATCH_LENGTH:g} m (below it the limit surface's "
+            f"arithmetic underflows), got {length!r}"
+        )
+    return length
+
+
 def rectangle(length: float, width: float) -> PolygonField:
     """Uniform pressure on a ``length`` x ``width`` [m] rectangle, long side along x, centred."""
-    a = validation.positive_scalar("length", length) / 2.0
-    b = validation.positive_scalar("width", width) / 2.0
+    a = _patch_length("length", length) / 2.0
+    b = _patch_length("width", width) / 2.0
     vertices = np.array([[-a, -b], [a, -b], [a, b], [-a, b]])
     vertices.setflags(write=False)
     return PolygonField(vertices=vertices)
@@ -327,6 +338,7 @@ def polygon(vertices, *, centered: bool = True) -> PolygonField:
     """
     points = validation.finite_array("vertices", vertices, shape=(None, 2))
     ccw = simple_polygon("vertices", points)
+    _patch_length("vertices' extent", float(np.max(np.ptp(ccw, axis=0))))
     if centered:
         ccw = ccw - polygon_centroid(ccw)
     ccw = np.array(ccw, dtype=float)
@@ -355,7 +367,7 @@ def points(xy, weights=None, *, centered: bool = True) -> PointsField:
     else:
         w = validation.finite_array("weights", weights, shape=(len(xy_array),))
         if np.any(w < 0.0):
-            raise InvalidArgumentError(f"weights must be >= 0, got {w.min()!r}")
+            raise InvalidArgumentError(f"weights must be >= 0, got {float(w.min())!r}")
         if not np.any(w > 0.0):
             raise InvalidArgumentError("weights are all zero: the points carry no force")
     loaded = w > 0.0
@@ -470,7 +482,9 @@ def grid(x, y, values, *, centered: bool = True) -> GridField:
         )
     if np.any(vals < 0.0):
         j, i = np.argwhere(vals < 0.0)[0]
-        raise InvalidArgumentError(f"values must be >= 0, got {vals[j, i]!r} at values[{j}][{i}]")
+        raise InvalidArgumentError(
+            f"values must be >= 0, got {float(vals[j, i])!r} at values[{j}][{i}]"
+        )
     if not np.any(vals > 0.0):
         raise InvalidArgumentError("values are all zero: the grid carries no pressure")
     field_ = GridField(x=xs, y=ys, values=vals)
