@@ -287,3 +287,11 @@ def test_coincident_candidates_keep_the_symmetries_and_the_optimum():
     assert search.stats.symmetries == 2
     expected = LayoutSearch(problem, candidates, choose=choose).run(top=1, mode="exact")
     assert best[0].objective_value == pytest.approx(expected[0].objective_value, rel=OPTIMUM_RTOL)
+
+
+def test_plan_points_a_layout_file_to_the_layout_command(capsys):
+    """(It listed its candidates and choose tables as unknown keys and asked for contacts.)"""
+    assert main(["plan", str(LAYOUT_FILE)]) == 2
+    error = capsys.readouterr().err
+    assert "candidates: a layout file" in error and "`fixplan layout FILE`" in error
+    assert "unknown key" not in error

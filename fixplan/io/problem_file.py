@@ -503,6 +503,10 @@ class _Reader:
     def document(self, data: dict) -> tuple[str | None, str | None, Problem | None]:
         """The file's name, kind and problem (``None`` where invalid)."""
         top = Table(data, "", self.issues)
+        if not self.layout and "candidates" in data:
+            top.report("candidates", "a layout file (candidate contacts to choose from): run it "
+                                     "with `fixplan layout FILE`")  # fmt: skip
+            return None, None, None
         top.check_keys(_TOP_KEYS + (_LAYOUT_KEYS if self.layout else ()))
         check_schema_version(top)
         name = top.get("name", _NAME, required=True)
