@@ -390,3 +390,12 @@ def test_bad_input_prints_one_line_and_no_traceback_from_the_installed_command(t
     assert result.stderr == (
         f"fixplan: error: {path}: line 2, column 3 (m): expected a number, got 'oops'\n"
     )
+
+
+def test_a_fit_is_not_saved_over_its_measurements(tmp_path, capsys):
+    """(``--save DATA.csv`` replaced the measurements with the fit's JSON.)"""
+    path = write_csv(tmp_path / "data.csv", *pairs())
+    before = path.read_bytes()
+    assert main(["fit", str(path), "--save", str(path)]) == EXIT_INVALID_INPUT
+    assert "that is the measurements' file" in capsys.readouterr().err
+    assert path.read_bytes() == before

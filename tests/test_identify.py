@@ -424,6 +424,7 @@ GOOD_LOADS, GOOD_TWISTS = synthetic(DISK, 40, seed=12)
         ((GOOD_LOADS[:6],), {}, "at least 6 fitted pairs"),
         ((GOOD_LOADS,), {"model": "cubic"}, "model must be one of"),
         ((GOOD_LOADS, GOOD_TWISTS), {"weight": 1e300}, "weight must be at most 10000"),
+        ((GOOD_LOADS,), {"seed": -1}, "seed must be an integer >= 0"),
         ((GOOD_LOADS,), {"holdout": 1.0}, "holdout must be a fraction"),
         ((GOOD_LOADS,), {"weight": -1.0}, "weight must be >= 0"),
         ((GOOD_LOADS * [1.0, 1.0, 0.0],), {}, "every moment is zero"),

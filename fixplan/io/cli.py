@@ -40,7 +40,7 @@ exit codes:
   {EXIT_OK}  success
   {EXIT_UNEXPECTED}  unexpected error
   {EXIT_INVALID_INPUT}  invalid input (bad file, option or value)
-  {EXIT_NOT_HELD}  cannot be held (infeasible, or a load case with safety factor < 1)
+  {EXIT_NOT_HELD}  cannot be held (infeasible, or a load case not held)
   {EXIT_SOLVER}  solver failure or inaccurate result
 """
 
@@ -825,6 +825,10 @@ def _run_fit(args: argparse.Namespace) -> tuple[int, str]:
         _check_output_folder(args.report, "--report")
     if args.save is not None:
         _check_output_file(args.save, "--save")
+        if args.save.exists() and args.save.samefile(args.file):
+            raise InvalidArgumentError(
+                f"--save {args.save}: that is the measurements' file; name another for the fit"
+            )
     log.info("fitting a %s to %d measurements of %s", args.model, data.rows, args.file)
     try:
         result = fit(data.fit_loads, data.twists, normal_force=normal_force or 1.0, **options)

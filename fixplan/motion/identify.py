@@ -326,8 +326,8 @@ def _program(cp, model, x, directions, weight, regularization, level_weights, tw
 
 
 def _rng(seed) -> np.random.Generator:
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
-        raise InvalidArgumentError(f"seed must be an integer, got {seed!r}")
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise InvalidArgumentError(f"seed must be an integer >= 0, got {seed!r}")
     return np.random.default_rng(int(seed))
 
 

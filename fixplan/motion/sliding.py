@@ -52,7 +52,7 @@ from scipy.optimize import brentq, root
 from fixplan import validation
 from fixplan.errors import ConvergenceError, InvalidArgumentError
 from fixplan.motion.forward_map import ForwardMap, forward_map
-from fixplan.tolerances import CONTAINMENT_RTOL
+from fixplan.tolerances import CONTAINMENT_RTOL, MAX_STEPS
 
 #: The body counts as stopped when its speed (with rotation counted at the radius of gyration)
 #: falls below this fraction of the run's speed scale.
@@ -143,8 +143,8 @@ def slide(
     duration : float
         Simulated time [s], > 0.
     samples : int
-        Evenly spaced samples returned (plus the instants the body stops; a resting body's
-        load is checked at them).
+        Evenly spaced samples returned, at most ``MAX_STEPS`` (plus the instants the body
+        stops; a resting body's load is checked at them).
     """
     friction = forward_map(surface)
     mass = validation.positive_scalar("mass", mass)
@@ -152,8 +152,11 @@ def slide(
     duration = validation.positive_scalar("duration", duration)
     twist = validation.finite_array("twist0", twist0, shape=(3,))
     pose = validation.finite_array("pose0", pose0, shape=(3,))
-    if isinstance(samples, bool) or not isinstance(samples, int | np.integer) or samples < 1:
-        raise InvalidArgumentError(f"samples must be a positive integer, got {samples!r}")
+    if (isinstance(samples, bool) or not isinstance(samples, int | np.integer)
+            or not 1 <= samples <= MAX_STEPS):  # fmt: skip
+        raise InvalidArgumentError(
+            f"samples must be an integer from 1 to {MAX_STEPS:,}, got {samples!r}"
+        )
     if load is not None and not callable(load):
         raise InvalidArgumentError(f"load must be a function of (t, pose) or None, got {load!r}")
     if load is None and not np.any(twist):
