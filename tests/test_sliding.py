@@ -79,9 +79,9 @@ def test_slide_needs_a_forward_map_and_a_moving_body_or_a_load():
         slide(LimitSurface(pressure.disk(RADIUS), mu=0.0), mass=MASS, inertia=INERTIA,
               twist0=[1, 0, 0], duration=1.0)  # fmt: skip
     with pytest.raises(InvalidArgumentError, match="samples must be an integer from 1 to"):
-        slide(
+        slide(  # (it never ended)
             PUCK, mass=MASS, inertia=INERTIA, twist0=[1, 0, 0], duration=1.0, samples=10**8
-        )  # fmt: skip (it never ended)
+        )
 
 
 # -- applied loads ------------------------------------------------------------------------------
