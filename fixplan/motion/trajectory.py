@@ -133,7 +133,7 @@ def push(
     if isinstance(steps, bool) or not isinstance(steps, int | np.integer) or steps < 1:
         raise InvalidArgumentError(f"steps must be a positive integer, got {steps!r}")
     pose = validation.finite_array("pose", pose, shape=(3,)).copy()
-    contact.check_start(pose)
+    _check_start(contact, pose)
     dt = duration / steps
     times, poses = [0.0], [pose.copy()]
     twists, modes, forces, points, counts = [], [], [], [], []
@@ -176,6 +176,18 @@ class _State:
     keys: tuple
 
 
+def _check_start(contact, pose: np.ndarray) -> None:
+    """Refuse a pusher (a contact's, :class:`_RoundContact` or :class:`_FaceContact`) that
+    starts inside the part at ``pose``: the push has no meaning then."""
+    overlap = -contact.gap(pose, 0.0)
+    if overlap > contact.tolerance:
+        (x, y), (pusher, advice) = contact.pusher.position(0.0), contact.describe()
+        raise GeometryError(
+            f"the {pusher} at ({x:g}, {y:g}) m overlaps the part at pose {tuple(pose.tolist())} "
+            f"by {overlap:.6g} m at t = 0: {advice}"
+        )
+
+
 class _RoundContact:
     """A round pusher on the outline: one contact point, where the outline is nearest."""
 
@@ -184,16 +196,10 @@ class _RoundContact:
         size = float(np.abs(shape.vertices).max()) if len(shape.vertices) else shape.radius
         self.tolerance = TOUCH_RTOL * max(size, pusher.radius)
 
-    def check_start(self, pose: np.ndarray) -> None:
-        """Refuse a pusher that starts inside the part (the push has no meaning then)."""
-        overlap = -self.gap(pose, 0.0)
-        if overlap > self.tolerance:
-            centre = self.pusher.position(0.0)
-            raise GeometryError(
-                f"the PointPusher of radius {self.pusher.radius:g} m starting at "
-                f"({centre[0]:g}, {centre[1]:g}) m overlaps the part at pose {tuple(pose.tolist())} by "
-                f"{overlap:.6g} m at t = 0: start it at least its radius outside the outline"
-            )
+    def describe(self) -> tuple[str, str]:
+        """The pusher in words, and how to start it outside the part (:func:`_check_start`)."""
+        return (f"PointPusher of radius {self.pusher.radius:g} m starting",
+                "start it at least its radius outside the outline")  # fmt: skip
 
     def gap(self, pose: np.ndarray, t: float) -> float:
         """Distance between the pusher's surface and the outline at time ``t`` [m]."""
@@ -237,16 +243,10 @@ class _FaceContact:
         return self.shape.face_points(_local(pose, self.pusher.position(t)), normal,
                                       self.pusher.width / 2)  # fmt: skip
 
-    def check_start(self, pose: np.ndarray) -> None:
-        """Refuse a face that starts inside the part (the push has no meaning then)."""
-        overlap = -self.gap(pose, 0.0)
-        if overlap > self.tolerance:
-            centre = self.pusher.position(0.0)
-            raise GeometryError(
-                f"the LinePusher of width {self.pusher.width:g} m centred at "
-                f"({centre[0]:g}, {centre[1]:g}) m overlaps the part at pose {tuple(pose.tolist())} by "
-                f"{overlap:.6g} m along its normal at t = 0: start its face outside the outline"
-            )
+    def describe(self) -> tuple[str, str]:
+        """The pusher in words, and how to start it outside the part (:func:`_check_start`)."""
+        return (f"LinePusher of width {self.pusher.width:g} m centred",
+                "start its face outside the outline (the overlap is along its normal)")  # fmt: skip
 
     def gap(self, pose: np.ndarray, t: float) -> float:
         """Height of the outline's lowest point in the strip above the face [m] (inf: none)."""
