@@ -99,8 +99,9 @@ def test_a_re_solve_after_an_unholdable_direct_one_with_a_given_force_and_a_new_
         for name, side, force in fingers
     ]  # fmt: skip
     mass = 10.0 if objective == "check" else 0.5
+    first = [Load(name="lift", force=[0, 0, lifts[0]])]
     problem = Problem(body=Body(mass=mass, center_of_mass=[0, 0, 0]), contacts=contacts,
-                      loads=[Load(name="lift", force=[0, 0, lifts[0]])], objective=objective)  # fmt: skip
+                      loads=first, objective=objective)  # fmt: skip
     planner = Planner(problem)
     for lift in lifts:
         loads = [Load(name="lift", force=[0, 0, lift])]

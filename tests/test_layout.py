@@ -240,7 +240,8 @@ def test_layout_command_json_lists_the_sampled_candidates_chosen(capsys):
         (("locator = 3", "locatr = 3"), "choose.locatr: unknown key; did you mean 'locator'?"),
         (("locator = 3", "locator = 9"), "choose['locator'] must be a count or [min, max]"),
         (("count = 6", "count = 0"), "candidates[7].sample.count"),
-        (("count = 6", "count = 1001"), "candidates[7].sample.count: expected an integer from 1 to 1000"),
+        (("count = 6", "count = 1001"),
+         "candidates[7].sample.count: expected an integer from 1 to 1000"),
         (("[[candidates]]\nname = \"rest-a\"", "[[contacts]]\nname = \"rest-a\"\nrole = "
           "\"locator\"\nposition = [0, 0, 0]\nnormal = [0, 0, 1]\n\n[[candidates]]\nname = "
           "\"rest-a\""), "contacts[0].name: contact name 'rest-a' is also a candidate's"),

@@ -474,7 +474,7 @@ def _inputs():
         "grid cells below a nanometre": (
             lambda: pressure.grid([0, 1e-11], [0, 0.01], np.ones((2, 2))),
             InvalidArgumentError,
-            ["x", "1e-11 m wide", "at least 1e-09 m"],
+            ["x: the cells' width must be at least 1e-09 m", "got 1e-11"],
         ),
         "grid of a needle's sides": (
             lambda: pressure.grid([0, 1e-8], [0, 0.01], np.ones((2, 2))),
@@ -489,7 +489,7 @@ def _inputs():
         "points spanning less than a nanometre": (
             lambda: pressure.points([[0, 0], [1e-300, 0]]),
             GeometryError,
-            ["xy", "span 1e-300 m", "at least 1e-09 m"],
+            ["xy: the loaded points' span must be at least 1e-09 m", "got 1e-300"],
         ),
         "grid values of the wrong shape": (
             lambda: pressure.grid([0, 1], [0, 1], np.ones((3, 2))),

@@ -64,8 +64,8 @@ class Outline:
             return normal * self.radius, normal, distance - self.radius
         start = self.vertices
         edge = np.roll(self.vertices, -1, axis=0) - start
-        along = np.clip(np.einsum("ij,ij->i", point - start, edge) / np.einsum("ij,ij->i", edge, edge),
-                        0.0, 1.0)  # fmt: skip
+        lengths = np.einsum("ij,ij->i", edge, edge)
+        along = np.clip(np.einsum("ij,ij->i", point - start, edge) / lengths, 0.0, 1.0)
         closest = start + along[:, None] * edge
         gaps = np.linalg.norm(point - closest, axis=1)
         best = int(np.argmin(gaps))
@@ -103,8 +103,8 @@ class Outline:
         the order of the edges."""
         start = self.vertices
         edge = np.roll(self.vertices, -1, axis=0) - start
-        along = np.clip(np.einsum("ij,ij->i", point - start, edge) / np.einsum("ij,ij->i", edge, edge),
-                        0.0, 1.0)  # fmt: skip
+        lengths = np.einsum("ij,ij->i", edge, edge)
+        along = np.clip(np.einsum("ij,ij->i", point - start, edge) / lengths, 0.0, 1.0)
         gaps = np.linalg.norm(point - (start + along[:, None] * edge), axis=1)
         gap = float(gaps.min())
         touching = np.flatnonzero(gaps <= gap + ON_OUTLINE_RTOL * max(gap, np.abs(edge).max()))

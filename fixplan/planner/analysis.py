@@ -220,9 +220,10 @@ def summary(
 ):  # pragma: no cover - compiled
     """The multiples of the two solves ``highest`` and ``lowest`` (empty: 0 for every case),
     cleaned into ``k_max`` and ``k_min`` (solver noise below 0, below ``atol`` as 0, from
-    ``cap`` on as infinity, ``k_min`` above ``k_max`` by less than ``held_rtol`` as ``k_max``), the held cases into
-    ``held`` and ``use`` ``(C, K)`` capped at 1 into ``utilisation``. Returns the critical case (the first of those tied within ``held_rtol``
-    with the smallest margin ``min(k_max, 1 / k_min)``) and its most used contact."""
+    ``cap`` on as infinity, ``k_min`` above ``k_max`` by less than ``held_rtol`` as ``k_max``),
+    the held cases into ``held`` and ``use`` ``(C, K)`` capped at 1 into ``utilisation``.
+    Returns the critical case (the first of those tied within ``held_rtol`` with the smallest
+    margin ``min(k_max, 1 / k_min)``) and its most used contact."""
     margins = np.empty(k_max.shape[0])
     for j in range(k_max.shape[0]):
         high = max(highest[j], 0.0)  # the solver may return -1e-19 for 0

@@ -24,8 +24,8 @@ limiting loads left inside their sets cost the objective, to first order their p
 L·V`` times the fractions they are inside, at most ``COMPLEMENTARITY_RTOL`` of it (of each
 case's multiple, in a fixed-force block). Loads of contacts that do not limit the optimum may
 be anywhere inside (an optimum's loads are often not unique). A fixed-force case whose multiple
-sits at a bound (0, or the cap) needs no stationarity: its exactly feasible loads prove that multiple optimal. A
-contact without load (not pressed) that takes part in the impending motion is held at no normal
+sits at a bound (0, or the cap) needs no stationarity: its exactly feasible loads prove that
+multiple optimal. A contact without load (not pressed) that takes part in the impending motion is held at no normal
 force because its set looks too small in the direction of its twist ``V``: its ellipsoid must
 reach as far as the exact set there (``SUPPORT_RTOL``), else it is moved to osculate at the
 exact set's point with normal ``V``. Rounds that do not get there (``MAX_ROUNDS``), or a

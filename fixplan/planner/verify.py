@@ -111,8 +111,9 @@ def equilibrium(normal_map, friction_map, normal, friction, wrenches, scale, gra
                 length_scale, sizes, ratios):  # fmt: skip  # pragma: no cover - compiled
     """Each case's largest residual of force and of moment (rows of ``ratios`` ``(2, K)``)
     over the size of its wrench terms and its task load at multiple 1 (``sizes``: the largest
-    force and moment of any term, moments at least force × ``length_scale``); returns the largest ratio (0 for no case) and
-    the largest magnitude of ``normal`` (see :func:`largest_magnitude`). A row with a term that
+    force and moment of any term, moments at least force × ``length_scale``); returns the
+    largest ratio (0 for no case) and the largest magnitude of ``normal`` (see
+    :func:`largest_magnitude`). A row with a term that
     is not finite (NaN or infinite) has an infinite residual."""
     largest = 0.0
     for k in range(normal.shape[1]):

@@ -313,7 +313,7 @@ def _patch_length(name: str, value) -> float:
     """``value`` [m] as a float of at least ``MIN_PATCH_LENGTH``."""
     length = validation.positive_scalar(name, value)
     if length < MIN_PATCH_LENGTH:
-        raise InvalidArgumentError(
+        raise GeometryError(
             f"{name} must be at least {MIN_PATCH_LENGTH:g} m (below it the limit surface's "
             f"arithmetic underflows), got {length!r}"
         )
@@ -351,9 +351,9 @@ def points(xy, weights=None, *, centered: bool = True) -> PointsField:
 
     Weights (default equal) must be >= 0 and are normalised to sum 1; points with zero weight are
     dropped (positive weights must be at least ``MIN_WEIGHT_RATIO`` of the largest: set
-    smaller ones to 0), and a point given more than once is one support carrying the sum of its weights
-    (the same field; the facet of a support point is its whole force's, which no copy alone
-    carries). At least two distinct loaded points are needed: a single point has no torsional
+    smaller ones to 0), and a point given more than once is one support carrying the sum of its
+    weights (the same field; the facet of a support point is its whole force's, which no copy
+    alone carries). At least two distinct loaded points are needed: a single point has no torsional
     friction (use a point-contact model). With ``centered`` (default) the points are moved so that
     their centre of pressure is the origin.
     """
@@ -380,11 +380,7 @@ def points(xy, weights=None, *, centered: bool = True) -> PointsField:
             "points needs at least two distinct loaded points; a single point has no torsional "
             "friction (use a point-contact model for it)"
         )
-    if span < MIN_PATCH_LENGTH:
-        raise GeometryError(
-            f"xy: the loaded points span {span!r} m; at least {MIN_PATCH_LENGTH:g} m (below it "
-            "the limit surface's arithmetic underflows): use a point-contact model"
-        )
+    _patch_length("xy: the loaded points' span", span)
     _check_separation(xy_array, span)
     if centered:
         xy_array = xy_array - w @ xy_array
@@ -468,11 +464,7 @@ def grid(x, y, values, *, centered: bool = True) -> GridField:
             raise InvalidArgumentError(
                 f"{name} must hold at least two cell centres to define the cell size"
             )
-        if steps[0] < MIN_PATCH_LENGTH:
-            raise InvalidArgumentError(
-                f"{name}: cells {float(steps[0])!r} m wide; at least {MIN_PATCH_LENGTH:g} m (below it "
-                "the limit surface's arithmetic underflows)"
-            )
+        _patch_length(f"{name}: the cells' width", float(steps[0]))
     extents = (len(xs) * float(xs[1] - xs[0]), len(ys) * float(ys[1] - ys[0]))
     if max(extents) > MAX_ASPECT_RATIO * min(extents):
         raise InvalidArgumentError(
