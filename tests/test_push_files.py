@@ -204,6 +204,7 @@ BAD_FILES = {
     "support.offset": _set("support.offset", [0.01, 0.0]),
     "simulation.steps": _set("simulation.steps", 0),
     "simulation.duration": _set("simulation.duration", math.inf),
+    "simulation.start_overlap": _set("simulation.start_overlap", -0.001),
     "part.mass": _set("part.mass", "heavy"),
     "part.outline": _set(
         "part.outline", {"shape": "polygon", "vertices": [[0, 0], [1, 1], [1, 0], [0, 1]]}
@@ -246,6 +247,27 @@ def test_a_pusher_that_starts_inside_the_part_is_invalid_input_naming_the_file(t
     assert main(["push", str(path)]) == EXIT_INVALID_INPUT
     err = capsys.readouterr().err
     assert f"{path}: pusher: the LinePusher" in err and "overlaps the part" in err
+
+
+def test_a_measured_start_inside_the_part_pushes_if_the_file_allows_its_overlap(tmp_path, capsys):
+    # The face starts 1.6 mm into the askew box: refused, unless simulation.start_overlap allows
+    # it; then it pushes as the same face set back by its overlap along its normal.
+    path = tmp_path / "measured.toml"
+    path.write_text(_mutated(_set("pusher.start", [-0.02, 0.0])), encoding="utf-8")
+    assert main(["push", str(path)]) == EXIT_INVALID_INPUT
+    assert "allow it with start_overlap" in capsys.readouterr().err
+    allowing = _set("simulation.start_overlap", 0.002)
+    path.write_text(_mutated(lambda d: (_set("pusher.start", [-0.02, 0.0])(d), allowing(d))),
+                    encoding="utf-8")  # fmt: skip
+    measured = load_push(path)
+    assert measured.start_overlap == 0.002
+    assert main(["push", str(path), "--json"]) == EXIT_OK
+    overlap = 0.02 * math.cos(0.2) + 0.01 * math.sin(0.2) - 0.02
+    set_back = LinePusher(([-0.02 - overlap, 0.0], [0.02, 0.0]), mu=0.3, width=0.08)
+    expected = push(measured.surface, set_back, shape=measured.shape, pose=measured.pose,
+                    duration=1.5, steps=60).poses[-1]  # fmt: skip
+    summary = json.loads(capsys.readouterr().out)
+    np.testing.assert_allclose(summary["final_pose"], expected, rtol=0.0, atol=1e-12)
 
 
 def test_fixplan_check_validates_a_push_file_and_plan_points_to_push(capsys):

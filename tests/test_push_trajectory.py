@@ -1,6 +1,8 @@
 """Pushing trajectories: straight pushes, contact made within a step, second-order convergence
 of the SE(2) midpoint integration, round parts and callable paths."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -195,6 +197,55 @@ def test_a_flat_pusher_that_starts_inside_the_part_is_refused():
         GeometryError, match=r"overlaps the part at pose \(0\.0, 0\.0, 0\.0\) by 0\.005 m"
     ):
         push(table, face, shape=box, duration=1.0, steps=10)
+
+
+def test_a_round_pusher_allowed_to_start_inside_pushes_as_one_smaller_by_its_overlap():
+    # A measured start: the cylinder's rim 2 mm into the box, its centre outside. The push is the
+    # one of a pusher of radius 3 mm on the same path, which starts just touching.
+    box = Outline.rectangle(0.09, 0.06)
+    table = LimitSurface(pressure.rectangle(0.09, 0.06), mu=0.3, normal_force=0.5 * 9.81)
+    path = ([-0.048, 0.012], [0.02, 0.003])
+    measured = push(table, PointPusher(path, mu=0.25, radius=0.005), shape=box, duration=1.0,
+                    steps=50, start_overlap=0.002)  # fmt: skip
+    touching = push(table, PointPusher(path, mu=0.25, radius=0.003), shape=box, duration=1.0,
+                    steps=50)  # fmt: skip
+    assert measured.modes[0] != "separated" and measured.poses[-1][0] > 0.015
+    np.testing.assert_allclose(measured.poses, touching.poses, rtol=0.0, atol=1e-15)
+
+
+def test_a_flat_pusher_allowed_to_start_inside_pushes_as_one_set_back_by_its_overlap():
+    box = Outline.rectangle(0.09, 0.06)
+    table = LimitSurface(pressure.rectangle(0.09, 0.06), mu=0.3, normal_force=0.5 * 9.81)
+    velocity = [0.02, 0.004]
+    measured = push(table, LinePusher(([-0.043, 0.01], velocity), mu=0.25, width=0.04,
+                                      normal=[1.0, 0.0]),
+                    shape=box, duration=1.0, steps=20, start_overlap=0.002)  # fmt: skip
+    touching = push(table, LinePusher(([-0.045, 0.01], velocity), mu=0.25, width=0.04,
+                                      normal=[1.0, 0.0]),
+                    shape=box, duration=1.0, steps=20)  # fmt: skip
+    assert measured.poses[-1][0] > 0.015
+    np.testing.assert_allclose(measured.poses, touching.poses, rtol=0.0, atol=1e-15)
+
+
+@pytest.mark.parametrize(("start", "allowed", "refused"), [
+    ([-0.048, 0.0], 0.001, "by 0.002 m at t = 0 (more than the start_overlap of 0.001 m)"),
+    ([-0.04, 0.0], 1.0, "by 0.01 m at t = 0 (its centre inside the outline)"),
+])  # fmt: skip
+def test_a_round_pusher_deeper_than_allowed_or_with_its_centre_inside_is_refused(
+    start, allowed, refused
+):
+    box = Outline.rectangle(0.09, 0.06)
+    table = LimitSurface(pressure.rectangle(0.09, 0.06), mu=0.3, normal_force=0.5 * 9.81)
+    finger = PointPusher((start, [0.02, 0.0]), mu=0.25, radius=0.005)
+    with pytest.raises(GeometryError, match=re.escape(refused)):
+        push(table, finger, shape=box, duration=1.0, steps=10, start_overlap=allowed)
+
+
+@pytest.mark.parametrize("allowed", [-1e-3, np.nan, "1 mm"])
+def test_a_start_overlap_that_is_no_length_is_refused(allowed):
+    finger = PointPusher(([-0.1, 0.0], [0.02, 0.0]), mu=0.25)
+    with pytest.raises(InvalidArgumentError, match="start_overlap"):
+        push(SUPPORT, finger, shape=BLOCK, duration=1.0, steps=10, start_overlap=allowed)
 
 
 @pytest.mark.parametrize("start", [[-0.045, 0.03], [-0.03, 0.03], [0.045, -0.03]])

@@ -763,7 +763,7 @@ def _run_push(args: argparse.Namespace) -> tuple[int, str]:
         trajectory = push(
             push_file.surface, push_file.pusher, shape=push_file.shape, pose=push_file.pose,
             duration=push_file.duration, steps=push_file.steps,
-            progress=_Progress("pushing", not args.quiet),
+            start_overlap=push_file.start_overlap, progress=_Progress("pushing", not args.quiet),
         )  # fmt: skip
     except GeometryError as exc:  # (a start the file's values allow one by one)
         raise InvalidArgumentError(f"{args.file}: pusher: {exc}") from None

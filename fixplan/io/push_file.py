@@ -39,6 +39,9 @@ Units are SI; angles in radians. The schema::
     [simulation]
     duration = 5.0                        # [s], required
     steps = 500                           # integration steps, required
+    start_overlap = 0.0                   # [m], default 0: how far the pusher may start inside
+                                          # the part (a measured start; a round pusher: below
+                                          # its radius)
 """
 
 from __future__ import annotations
@@ -106,7 +109,7 @@ _OUTLINE_KEYS = {
     "polygon": ("shape", "vertices"),
     "disk": ("shape", "radius"),
 }
-_SIMULATION_KEYS = ("duration", "steps")
+_SIMULATION_KEYS = ("duration", "steps", "start_overlap")
 
 _COORDINATE = Number("", MAX_LENGTH, "m")
 _POINT = Array((2,), _COORDINATE)
@@ -148,6 +151,8 @@ class PushFile:
         Pushing time [s].
     steps : int
         Integration steps.
+    start_overlap : float
+        How far the pusher may start inside the part [m].
     normal_force : float
         The part's weight on the support [N].
     support_mu : float
@@ -164,6 +169,7 @@ class PushFile:
     pose: tuple[float, float, float]
     duration: float
     steps: int
+    start_overlap: float
     normal_force: float
     support_mu: float
 
@@ -217,11 +223,11 @@ def load_push(path: str | os.PathLike[str]) -> PushFile:
         surface = build(support_table, Ellipsoid.from_limit_surface, ls=surface)
     if issues or surface is None:
         raise ProblemFileError(path, issues)
-    duration, steps = simulation
+    duration, steps, start_overlap = simulation
     return PushFile(
         name=name, path=path, sha256=hashlib.sha256(content).hexdigest(), surface=surface,
         model=model, shape=shape, pusher=pusher, pose=tuple(pose), duration=duration,
-        steps=steps, normal_force=normal_force, support_mu=mu,
+        steps=steps, start_overlap=start_overlap, normal_force=normal_force, support_mu=mu,
     )  # fmt: skip
 
 
@@ -317,9 +323,10 @@ def _simulation(table: Table | None):
     table.check_keys(_SIMULATION_KEYS)
     duration = table.get("duration", _DURATION, required=True)
     steps = table.get("steps", _STEPS, required=True)
+    start_overlap = table.get("start_overlap", _RADIUS, default=0.0)
     if len(table.issues) > start:
         return None
-    return duration, steps
+    return duration, steps, start_overlap
 
 
 def _outline_pressure(shape: Outline) -> pressure.PressureField:

@@ -109,6 +109,7 @@ def push(
     pose=(0.0, 0.0, 0.0),
     duration: float,
     steps: int,
+    start_overlap: float = 0.0,
     progress: Callable[[int, int], None] | None = None,
 ) -> Trajectory:
     """Integrate the part's quasi-static motion under ``pusher`` for ``duration`` [s].
@@ -118,6 +119,13 @@ def push(
     :func:`~fixplan.motion.line_push_step`); ``shape`` the part's outline in the same frame;
     ``pose`` its initial world pose ``(x, y, θ)``; ``steps`` the number of integration steps;
     ``progress(done, total)`` is called after each step.
+
+    The pusher must start outside the part, or overlap it by at most ``start_overlap`` [m]
+    (default 0): a measured start carries such errors (in the MIT push data, half the pushes
+    start with the cylinder up to 3.4 mm into the part). An overlapping pusher touches the part
+    from the start and keeps its overlap, pushing as if set back along its normal by it: a round
+    one at the outline point nearest its centre (so its overlap is below its radius, the centre
+    outside), a flat one with its face that far behind it.
     """
     if not isinstance(shape, Outline):
         raise InvalidArgumentError(f"shape must be an Outline, got {type(shape).__name__}")
@@ -133,7 +141,8 @@ def push(
     if isinstance(steps, bool) or not isinstance(steps, int | np.integer) or steps < 1:
         raise InvalidArgumentError(f"steps must be a positive integer, got {steps!r}")
     pose = validation.finite_array("pose", pose, shape=(3,)).copy()
-    _check_start(contact, pose)
+    start_overlap = validation.nonnegative_scalar("start_overlap", start_overlap)
+    contact.start(pose, start_overlap)
     dt = duration / steps
     times, poses = [0.0], [pose.copy()]
     twists, modes, forces, points, counts = [], [], [], [], []
@@ -176,16 +185,23 @@ class _State:
     keys: tuple
 
 
-def _check_start(contact, pose: np.ndarray) -> None:
-    """Refuse a pusher (a contact's, :class:`_RoundContact` or :class:`_FaceContact`) that
-    starts inside the part at ``pose``: the push has no meaning then."""
+def _start_overlap(contact, pose: np.ndarray, allowed: float) -> float:
+    """How far the pusher of a contact (:class:`_RoundContact` or :class:`_FaceContact`) starts
+    inside the part at ``pose`` [m] (negative: outside); one deeper than ``allowed`` [m] or than
+    the contact allows is refused, as the push has no meaning then."""
     overlap = -contact.gap(pose, 0.0)
-    if overlap > contact.tolerance:
+    if overlap > min(allowed, contact.deepest_start) + contact.tolerance:
         (x, y), (pusher, advice) = contact.pusher.position(0.0), contact.describe()
+        allowance = ""
+        if overlap > allowed + contact.tolerance and allowed > 0.0:
+            allowance = f" (more than the start_overlap of {allowed:g} m)"
+        elif allowed > 0.0:  # (only a round pusher has a deepest start)
+            allowance = " (its centre inside the outline)"
         raise GeometryError(
             f"the {pusher} at ({x:g}, {y:g}) m overlaps the part at pose {tuple(pose.tolist())} "
-            f"by {overlap:.6g} m at t = 0: {advice}"
+            f"by {overlap:.6g} m at t = 0{allowance}: {advice}"
         )
+    return overlap
 
 
 class _RoundContact:
@@ -195,11 +211,19 @@ class _RoundContact:
         self.surface, self.shape, self.pusher = surface, shape, pusher
         size = float(np.abs(shape.vertices).max()) if len(shape.vertices) else shape.radius
         self.tolerance = TOUCH_RTOL * max(size, pusher.radius)
+        #: The largest overlap at the start that keeps the centre outside the outline [m].
+        self.deepest_start = pusher.radius
+
+    def start(self, pose: np.ndarray, allowed: float) -> None:
+        """Check the start at ``pose`` (:func:`_start_overlap`). An overlap stays: the contact
+        is the outline point nearest the centre, as for a pusher smaller by the overlap."""
+        _start_overlap(self, pose, allowed)
 
     def describe(self) -> tuple[str, str]:
-        """The pusher in words, and how to start it outside the part (:func:`_check_start`)."""
+        """The pusher in words, and how to start it outside the part (:func:`_start_overlap`)."""
         return (f"PointPusher of radius {self.pusher.radius:g} m starting",
-                "start it at least its radius outside the outline")  # fmt: skip
+                "start it at least its radius outside the outline (or, for a measured start, "
+                "allow an overlap below its radius with start_overlap)")  # fmt: skip
 
     def gap(self, pose: np.ndarray, t: float) -> float:
         """Distance between the pusher's surface and the outline at time ``t`` [m]."""
@@ -236,17 +260,26 @@ class _FaceContact:
         self.surface, self.shape, self.pusher = surface, shape, pusher
         size = float(np.abs(shape.vertices).max()) if len(shape.vertices) else shape.radius
         self.tolerance = TOUCH_RTOL * size
+        self.deepest_start = math.inf
+        #: How far behind the pusher the face acts [m]: a start's overlap (:meth:`start`).
+        self.set_back = 0.0
+
+    def start(self, pose: np.ndarray, allowed: float) -> None:
+        """Check the start at ``pose`` (:func:`_start_overlap`); an overlap sets the face back
+        along its normal by as much, as the round pusher's overlap does."""
+        self.set_back = max(_start_overlap(self, pose, allowed), 0.0)
 
     def points(self, pose: np.ndarray, t: float):
         """The outline's candidate contact points with the face at time ``t``."""
         normal = _rotation(pose[2]).T @ self.pusher.normal
-        return self.shape.face_points(_local(pose, self.pusher.position(t)), normal,
-                                      self.pusher.width / 2)  # fmt: skip
+        face = self.pusher.position(t) - self.set_back * self.pusher.normal
+        return self.shape.face_points(_local(pose, face), normal, self.pusher.width / 2)
 
     def describe(self) -> tuple[str, str]:
-        """The pusher in words, and how to start it outside the part (:func:`_check_start`)."""
+        """The pusher in words, and how to start it outside the part (:func:`_start_overlap`)."""
         return (f"LinePusher of width {self.pusher.width:g} m centred",
-                "start its face outside the outline (the overlap is along its normal)")  # fmt: skip
+                "start its face outside the outline (the overlap is along its normal; for a "
+                "measured start, allow it with start_overlap)")  # fmt: skip
 
     def gap(self, pose: np.ndarray, t: float) -> float:
         """Height of the outline's lowest point in the strip above the face [m] (inf: none)."""
