@@ -27,6 +27,12 @@ HESSIAN_STEP = 1e-6
 #: integrand is used instead.
 FAR_FIELD_RADII = 4.0
 
+#: Largest relative disagreement of a user's pressure or friction function's two quadrature
+#: rules (about a centre of rotation near the patch, and fixed), probed where both apply: smooth
+#: fields agree to 1e-14; steps, kinks and peaks too narrow for the rules disagree by 1e-5 to 1
+#: (their answers are off by as much, and the inverse map often fails to converge on them).
+QUADRATURE_RTOL = 1e-6
+
 #: The planner's equilibrium residual must be below this fraction of the largest wrench term.
 EQUILIBRIUM_RTOL = 1e-6
 

@@ -59,7 +59,7 @@ from fixplan.surface.pressure import (
 )
 from fixplan.surface.rules import triangle_rule
 from fixplan.surface.sphere import circle, fibonacci_sphere
-from fixplan.tolerances import CONTAINMENT_RTOL, MIN_FRICTION_FORCE
+from fixplan.tolerances import CONTAINMENT_RTOL, MIN_FRICTION_FORCE, QUADRATURE_RTOL
 
 #: Gauss order per triangle of the far-field rule of polygons (exact to machine precision for
 #: centres of rotation beyond FAR_FIELD_RADII patch radii).
@@ -94,6 +94,8 @@ class LimitSurface:
         Friction coefficient, a constant >= 0 or a function ``mu(x, y)`` >= 0 of contact-frame
         coordinates [m] returning arrays. A function must be smooth over the patch and positive
         somewhere on it; a patch of two materials is two patches summed with :meth:`combine`.
+        One the quadrature does not resolve to ``QUADRATURE_RTOL`` (as for ``p`` of
+        :func:`~fixplan.pressure.from_function`) is refused, except on point supports.
         ``mu = 0`` is a frictionless contact (see the module docstring).
     normal_force : float
         Total normal force [N], > 0.
@@ -484,8 +486,8 @@ def _field_kernel(field: PressureField) -> SupportKernel:
     elif isinstance(field, FunctionField):
         from fixplan.surface.function_kernel import FunctionKernel
 
-        local = FunctionKernel(
-            regions=_regions(field.shape), pressure=field.function, friction=None
+        local = _resolved(
+            FunctionKernel(regions=_regions(field.shape), pressure=field.function), "p(x, y)"
         )
     else:  # pragma: no cover - every field class is handled above
         raise InvalidArgumentError(f"unsupported field type {type(field).__name__}")
@@ -588,4 +590,24 @@ def _varying_friction_kernel(field: PressureField, mu: Callable) -> SupportKerne
         regions, pressure = _regions(field.shape), field.function
     else:  # pragma: no cover
         raise InvalidArgumentError(f"unsupported field type {type(field).__name__}")
-    return _posed(FunctionKernel(regions=regions, pressure=pressure, friction=local_mu), pose)
+    kernel = FunctionKernel(regions=regions, pressure=pressure, friction=local_mu)
+    what = "mu(x, y) times p(x, y)" if isinstance(field, FunctionField) else "mu(x, y)"
+    return _posed(_resolved(kernel, what), pose)
+
+
+def _resolved(kernel: SupportKernel, what: str) -> SupportKernel:
+    """``kernel`` (a ``FunctionKernel`` of a user's function ``what``), checked to be resolved
+    by its quadrature (:meth:`~fixplan.surface.function_kernel.FunctionKernel.rule_disagreement`
+    within ``QUADRATURE_RTOL``)."""
+    disagreement = kernel.rule_disagreement()
+    if disagreement > QUADRATURE_RTOL:
+        raise InvalidArgumentError(
+            f"{what} is not smooth enough for the limit surface's quadrature: its rules about a "
+            f"centre of rotation near the patch and far from it disagree by {disagreement:.1e} "
+            f"of the friction power (smooth fields agree to 1e-14; up to {QUADRATURE_RTOL:g} is "
+            "accepted), and its answers would be off by about as much. Where it jumps or has a kink "
+            "(a step in pressure, two materials), describe each smooth region as its own patch "
+            "and sum them with LimitSurface.combine; sample a peak narrower than about a tenth "
+            "of the patch on a pressure.grid"
+        )
+    return kernel

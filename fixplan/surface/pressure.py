@@ -494,7 +494,11 @@ def from_function(shape: DiskField | PolygonField, p: Callable) -> FunctionField
     """Arbitrary pressure ``p(x, y) >= 0`` over a uniform ``shape`` (a disk or polygon field).
 
     ``p`` takes arrays of local coordinates [m] and returns relative pressures. The patch keeps
-    the shape's origin (its centroid), not the centre of pressure.
+    the shape's origin (its centroid), not the centre of pressure. ``p`` must be smooth over the
+    patch: its limit surface integrates it by rules adapted to the centre of rotation, not to
+    jumps, kinks or narrow peaks of ``p``, and refuses one they do not resolve to
+    ``QUADRATURE_RTOL`` (a step: describe each smooth region as its own patch and sum their
+    surfaces with ``LimitSurface.combine``; a narrow peak: sample it with :func:`grid`).
     """
     if not isinstance(shape, DiskField | PolygonField) or (
         isinstance(shape, DiskField) and shape.profile != "uniform"
