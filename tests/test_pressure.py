@@ -491,6 +491,41 @@ def _inputs():
             GeometryError,
             ["xy: the loaded points' span must be at least 1e-09 m", "got 1e-300"],
         ),
+        "rectangle beyond a kilometre": (
+            lambda: pressure.rectangle(1e200, 1e200),
+            GeometryError,
+            ["length must be at most 1000 m", "1e+200"],
+        ),
+        "disk beyond a kilometre": (
+            lambda: pressure.disk(1e10),
+            GeometryError,
+            ["radius must be at most 1000 m"],
+        ),
+        "polygon beyond a kilometre from the origin": (
+            lambda: pressure.polygon([[1e200, 0], [1e200 + 1, 0], [1e200, 1]], centered=False),
+            GeometryError,
+            ["vertices must lie within 1000 m of the origin"],
+        ),
+        "points beyond a kilometre from the origin": (
+            lambda: pressure.points([[1e5, 0], [1e5 + 1, 0]]),
+            GeometryError,
+            ["xy must lie within 1000 m of the origin", "100001.0"],
+        ),
+        "grid beyond a kilometre from the origin": (
+            lambda: pressure.grid([0, 1], [1e4, 1e4 + 1], np.ones((2, 2))),
+            GeometryError,
+            ["y must lie within 1000 m of the origin"],
+        ),
+        "field shifted beyond a kilometre": (
+            lambda: disk.shifted(0.0, 1e4),
+            GeometryError,
+            ["placed origin must lie within 1000 m", "10000.0"],
+        ),
+        "field rotated beyond a kilometre": (
+            lambda: disk.rotated(1.0, about=(1e4, 0.0)),
+            GeometryError,
+            ["placed origin must lie within 1000 m"],
+        ),
         "grid values of the wrong shape": (
             lambda: pressure.grid([0, 1], [0, 1], np.ones((3, 2))),
             InvalidArgumentError,

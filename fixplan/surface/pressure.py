@@ -38,6 +38,7 @@ from fixplan.surface.rules import gauss_jacobi_unit, triangle_rule
 from fixplan.tolerances import (
     MAX_ANNULUS_RATIO,
     MAX_ASPECT_RATIO,
+    MAX_LENGTH,
     MIN_PATCH_LENGTH,
     MIN_POINT_GAP_RATIO,
     MIN_WEIGHT_RATIO,
@@ -111,13 +112,18 @@ class PressureField(ABC):
         """The same field translated by ``(dx, dy)`` [m]."""
         dx = validation.finite_scalar("dx", dx)
         dy = validation.finite_scalar("dy", dy)
-        return dataclasses.replace(self, pose=self.pose.shifted(dx, dy))
+        return self._placed(self.pose.shifted(dx, dy))
 
     def rotated(self, angle: float, about: tuple[float, float] = (0.0, 0.0)) -> PressureField:
         """The same field rotated by ``angle`` [rad] counter-clockwise about ``about`` [m]."""
         angle = validation.finite_scalar("angle", angle)
         about_xy = validation.finite_array("about", about, shape=(2,))
-        return dataclasses.replace(self, pose=self.pose.rotated(angle, tuple(about_xy)))
+        return self._placed(self.pose.rotated(angle, tuple(about_xy)))
+
+    def _placed(self, pose: Pose) -> PressureField:
+        """The same field at ``pose``, whose offset must stay within ``MAX_LENGTH``."""
+        _coordinates("the field's placed origin", np.array(pose.offset))
+        return dataclasses.replace(self, pose=pose)
 
 
 def friction_values(mu: Callable, points: np.ndarray) -> np.ndarray:
@@ -310,14 +316,27 @@ def disk(
 
 
 def _patch_length(name: str, value) -> float:
-    """``value`` [m] as a float of at least ``MIN_PATCH_LENGTH``."""
+    """``value`` [m] as a float from ``MIN_PATCH_LENGTH`` to ``MAX_LENGTH``."""
     length = validation.positive_scalar(name, value)
     if length < MIN_PATCH_LENGTH:
         raise GeometryError(
             f"{name} must be at least {MIN_PATCH_LENGTH:g} m (below it the limit surface's "
             f"arithmetic underflows), got {length!r}"
         )
+    if length > MAX_LENGTH:
+        raise GeometryError(f"{name} must be at most {MAX_LENGTH:g} m, got {length!r}")
     return length
+
+
+def _coordinates(name: str, values: np.ndarray) -> np.ndarray:
+    """``values`` [m], checked within ``MAX_LENGTH`` of the origin (areas and moments of
+    farther ones overflow)."""
+    largest = float(np.max(np.abs(values), initial=0.0))
+    if largest > MAX_LENGTH:
+        raise GeometryError(
+            f"{name} must lie within {MAX_LENGTH:g} m of the origin, got {largest!r}"
+        )
+    return values
 
 
 def rectangle(length: float, width: float) -> PolygonField:
@@ -336,7 +355,9 @@ def polygon(vertices, *, centered: bool = True) -> PolygonField:
     the given coordinates are kept. Raises :class:`GeometryError` for self-intersecting or
     degenerate polygons.
     """
-    points = validation.finite_array("vertices", vertices, shape=(None, 2))
+    points = _coordinates(
+        "vertices", validation.finite_array("vertices", vertices, shape=(None, 2))
+    )
     ccw = simple_polygon("vertices", points)
     _patch_length("vertices' extent", float(np.max(np.ptp(ccw, axis=0))))
     if centered:
@@ -357,7 +378,7 @@ def points(xy, weights=None, *, centered: bool = True) -> PointsField:
     friction (use a point-contact model). With ``centered`` (default) the points are moved so that
     their centre of pressure is the origin.
     """
-    xy_array = validation.finite_array("xy", xy, shape=(None, 2))
+    xy_array = _coordinates("xy", validation.finite_array("xy", xy, shape=(None, 2)))
     if len(xy_array) == 0:
         raise InvalidArgumentError(
             "xy must hold at least two distinct loaded points (n >= 2), got an empty set"
@@ -451,8 +472,8 @@ def grid(x, y, values, *, centered: bool = True) -> GridField:
     Centres must be equally spaced and increasing. With ``centered`` (default) the map is moved
     so that its centre of pressure is the origin.
     """
-    xs = validation.finite_array("x", x, shape=(None,))
-    ys = validation.finite_array("y", y, shape=(None,))
+    xs = _coordinates("x", validation.finite_array("x", x, shape=(None,)))
+    ys = _coordinates("y", validation.finite_array("y", y, shape=(None,)))
     vals = validation.finite_array("values", values, shape=(len(ys), len(xs)))
     for name, axis in (("x", xs), ("y", ys)):
         steps = np.diff(axis)
