@@ -260,7 +260,7 @@ class _FaceContact:
         self.surface, self.shape, self.pusher = surface, shape, pusher
         size = float(np.abs(shape.vertices).max()) if len(shape.vertices) else shape.radius
         self.tolerance = TOUCH_RTOL * size
-        self.deepest_start = math.inf
+        self.deepest_start = math.inf  # (any overlap along the normal is a set-back)
         #: How far behind the pusher the face acts [m]: a start's overlap (:meth:`start`).
         self.set_back = 0.0
 

@@ -566,10 +566,10 @@ class FunctionKernel(SupportKernel):
 
     def rule_disagreement(self) -> float:
         """Largest difference of ``h`` between the polar rule about a centre of rotation near a
-        region and the fixed rule there (relative to the largest ``h`` of the centres tried), at centres where both are accurate for
-        smooth fields (half and nine tenths of the near range, ``FAR_FIELD_RADII`` reaches):
-        about 1e-14 then; of the order of the error of both where ``p`` or ``mu`` jumps, has a
-        kink or a peak the rules do not resolve."""
+        region and the fixed rule there, relative to the largest ``h`` of the centres tried
+        (``_PROBE_FRACTIONS`` of the near range of ``FAR_FIELD_RADII`` reaches, where both rules
+        are accurate for smooth fields): about 1e-14 then; of the order of the error of both
+        where ``p`` or ``mu`` jumps, has a kink or a peak the rules do not resolve."""
         lay = self._layout
         count = len(lay.kinds)
         regions = np.unique(np.linspace(0, count - 1, min(count, _PROBED_REGIONS)).astype(int))

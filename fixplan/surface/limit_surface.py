@@ -605,9 +605,9 @@ def _resolved(kernel: SupportKernel, what: str) -> SupportKernel:
             f"{what} is not smooth enough for the limit surface's quadrature: its rules about a "
             f"centre of rotation near the patch and far from it disagree by {disagreement:.1e} "
             f"of the friction power (smooth fields agree to 1e-14; up to {QUADRATURE_RTOL:g} is "
-            "accepted), and its answers would be off by about as much. Where it jumps or has a kink "
-            "(a step in pressure, two materials), describe each smooth region as its own patch "
-            "and sum them with LimitSurface.combine; sample a peak narrower than about a tenth "
-            "of the patch on a pressure.grid"
+            "accepted), and its answers would be off by about as much. Where it jumps or has a "
+            "kink (a step in pressure, two materials), describe each smooth region as its own "
+            "patch and sum them with LimitSurface.combine; sample a narrow peak on a "
+            "pressure.grid"
         )
     return kernel
