@@ -349,6 +349,26 @@ def test_three_point_contact_set_surface_equals_the_planar_limit_surface_of_the_
         assert np.linalg.norm(np.cross(motion, expected)) < 1e-4
 
 
+def test_a_contact_set_surface_is_homogeneous_in_loads_and_twists_of_any_magnitude():
+    # (The solver sees unit directions: raw loads of 1e300 N made Clarabel fail.)
+    contacts = [
+        Contact(name=f"c{k}", role="support", position=[x, y, 0.0], normal=[0, 0, 1], mu=0.4,
+                model=model, patch=pressure.disk(0.01))
+        for k, (x, y, model) in enumerate([(0.05, 0.0, "ellipsoid"), (-0.05, 0.03, "pyramid"),
+                                           (-0.05, -0.03, "point-cone")])
+    ]  # fmt: skip
+    surface = ContactSetSurface(contacts, [10.0, 20.0, 5.0], ("fx", "fy", "mz"))
+    load, twist = np.array([1.0, 0.5, 0.01]), np.array([0.3, 0.2, 0.1])
+    motion, safety = surface.motion_and_safety_factor(load)
+    support = surface.support(twist)
+    for scale in (1e-300, 1e-100, 1e100, 1e300):
+        scaled_motion, scaled_safety = surface.motion_and_safety_factor(scale * load)
+        assert scaled_safety * scale == pytest.approx(safety, rel=1e-9)
+        np.testing.assert_allclose(scaled_motion, motion, atol=1e-9)
+        assert surface.support(scale * twist) / scale == pytest.approx(support, rel=1e-9)
+    assert surface.support([0.0, 0.0, 0.0]) == 0.0
+
+
 @pytest.mark.parametrize(
     ("change", "message"),
     [

@@ -115,9 +115,12 @@ class ContactSetSurface:
     def support(self, twist) -> float:
         """Support function ``max w·V`` over the set for a subspace twist ``V``."""
         direction = _vector("twist", twist, len(self.subspace))
-        self._direction.value = direction
+        if not np.any(direction):
+            return 0.0
+        unit, size = _unit(direction)  # (h is homogeneous: the solver sees a unit twist)
+        self._direction.value = unit
         self._solve(self._support)
-        return float(self._support.value)
+        return float(self._support.value) * size
 
     def load(self, twist) -> np.ndarray:
         """A wrench on the surface that sustains sliding with ``twist`` (a support point)."""
@@ -129,7 +132,9 @@ class ContactSetSurface:
         wrench = _vector("load", load, len(self.subspace))
         if not np.any(wrench):
             return np.full(len(self.subspace), np.nan), float("inf")
-        self._direction.value = wrench
+        # (The gauge is homogeneous: the solver sees the load at the scale of the axis extents.)
+        unit, size = _unit(wrench / self._units)
+        self._direction.value = unit * self._units
         try:
             self._solve(self._gauge)
         except FixplanError:
@@ -139,7 +144,7 @@ class ContactSetSurface:
         twist = -np.asarray(self._balance.dual_value, dtype=float)
         twist = twist if twist @ wrench >= 0.0 else -twist
         norm = np.linalg.norm(twist)
-        return (twist / norm if norm > 0 else twist), float(self._scale.value)
+        return (twist / norm if norm > 0 else twist), float(self._scale.value) / size
 
     def safety_factor(self, load) -> float:
         """Factor ``s`` with ``s * load`` on the surface (``inf`` if unbounded or zero)."""
@@ -182,6 +187,14 @@ class ContactSetSurface:
             load[index] = direction * self._units[index]
             points.append(load[index] * self.safety_factor(load))
         return np.array(points)
+
+
+def _unit(vector: np.ndarray) -> tuple[np.ndarray, float]:
+    """``vector`` (nonzero) as a unit vector and its norm, without overflow or underflow."""
+    peak = float(np.max(np.abs(vector)))
+    scaled = vector / peak
+    norm = float(np.linalg.norm(scaled))
+    return scaled / norm, peak * norm
 
 
 def _vector(name: str, value, size: int) -> np.ndarray:
