@@ -6,6 +6,8 @@ import dataclasses
 import itertools
 import json
 import math
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -211,6 +213,16 @@ def test_large_mode_reaches_the_exact_optimum_of_the_plate_visiting_fewer_layout
     (exact, enumerated), (large, visited) = found["exact"], found["large"]
     assert large.objective_value == pytest.approx(exact.objective_value, rel=OPTIMUM_RTOL)
     assert visited.layouts < enumerated.layouts
+
+
+def test_the_layout_command_writes_nothing_else_to_stderr_when_quiet():
+    # (HiGHS prints a banner when its first instance is made, on the C-level streams.)
+    result = subprocess.run(
+        [sys.executable, "-m", "fixplan.io.cli", "layout", str(LAYOUT_FILE), "--top", "1", "-q"],
+        capture_output=True, text=True,
+    )  # fmt: skip
+    assert result.returncode == 0 and "rest-" in result.stdout
+    assert result.stderr == ""
 
 
 def test_layout_command_prints_the_best_layouts_and_writes_the_report(tmp_path, capsys):

@@ -16,6 +16,10 @@ Nothing else is concluded from a feasible program.
 
 from __future__ import annotations
 
+import contextlib
+import os
+import sys
+
 import highspy
 import numpy as np
 import scipy.sparse as sp
@@ -134,7 +138,27 @@ class _Program:
         lp.a_matrix_.start_ = matrix.indptr.astype(np.int32)
         lp.a_matrix_.index_ = matrix.indices.astype(np.int32)
         lp.a_matrix_.value_ = matrix.data
-        highs = highspy.Highs()
+        with _silenced_streams():  # (its constructor prints a banner, once per process)
+            highs = highspy.Highs()
         highs.setOptionValue("output_flag", False)
         highs.passModel(lp)
         return highs
+
+
+@contextlib.contextmanager
+def _silenced_streams():
+    """The process's standard output and error (file descriptors 1 and 2, where compiled code
+    writes) sent to the null device for the duration."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = os.dup(1), os.dup(2)
+    null = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(null, 1)
+        os.dup2(null, 2)
+        yield
+    finally:
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        for descriptor in (*saved, null):
+            os.close(descriptor)
