@@ -131,6 +131,20 @@ def test_polygon_keeps_its_coordinates_when_not_centered():
     assert np.allclose(field.center_of_pressure(), _L_CENTROID, rtol=1e-13)
 
 
+@pytest.mark.parametrize("offset", [1.0, 500.0, -999.0])
+def test_a_small_polygon_far_from_the_origin_keeps_its_area_and_centroid(offset):
+    # A 2 x 1 µm rectangle: shoelace sums about the origin lost its area to cancellation at
+    # 500 m ("degenerate: its area is zero"); about its first vertex only the rounding of its
+    # coordinates (ulp 1.1e-13 m at 500 m) remains.
+    corners = np.array([[0.0, 0.0], [2e-6, 0.0], [2e-6, 1e-6], [0.0, 1e-6]]) + offset
+    field = pressure.polygon(corners, centered=False)
+    rounding = 4.0 * np.spacing(abs(offset)) / 1e-6
+    assert field.area == pytest.approx(2e-12, rel=rounding)
+    # (The centre of pressure is a quadrature's weighted sum of points at |offset|: 12 ulp.)
+    np.testing.assert_allclose(field.center_of_pressure(), offset + np.array([1e-6, 0.5e-6]),
+                               rtol=0.0, atol=16.0 * np.spacing(abs(offset)))  # fmt: skip
+
+
 def test_clockwise_polygon_gives_the_same_field_as_counter_clockwise():
     ccw = pressure.polygon(L_SHAPE)
     cw = pressure.polygon(L_SHAPE[::-1])

@@ -57,18 +57,21 @@ class Pose:
 
 
 def signed_area(vertices: np.ndarray) -> float:
-    """Signed area of a polygon ``(n, 2)`` [m^2]; positive when counter-clockwise."""
-    x, y = vertices[:, 0], vertices[:, 1]
+    """Signed area of a polygon ``(n, 2)`` [m^2]; positive when counter-clockwise (the
+    shoelace sum about its first vertex: about the origin, a small polygon far from it would
+    lose its area to cancellation)."""
+    x, y = (vertices - vertices[0]).T
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
 
 
 def polygon_centroid(vertices: np.ndarray) -> np.ndarray:
-    """Area centroid of a simple polygon ``(n, 2)`` [m]."""
-    x, y = vertices[:, 0], vertices[:, 1]
+    """Area centroid of a simple polygon ``(n, 2)`` [m] (sums about its first vertex)."""
+    x, y = (vertices - vertices[0]).T
     xn, yn = np.roll(x, -1), np.roll(y, -1)
     cross = x * yn - xn * y
     area = 0.5 * cross.sum()
-    return np.array([((x + xn) * cross).sum(), ((y + yn) * cross).sum()]) / (6.0 * area)
+    moments = np.array([((x + xn) * cross).sum(), ((y + yn) * cross).sum()])
+    return vertices[0] + moments / (6.0 * area)
 
 
 def _segments_cross(p1, p2, q1, q2) -> bool:
