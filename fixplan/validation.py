@@ -41,6 +41,15 @@ def nonnegative_scalar(name: str, value: object) -> float:
     return number + 0.0
 
 
+def unit_vector(vector: np.ndarray) -> tuple[np.ndarray, float]:
+    """A finite, nonzero ``vector`` as a unit vector and its norm, without the overflow or
+    underflow of squaring its entries (it is scaled by its largest entry first)."""
+    peak = float(np.max(np.abs(vector)))
+    scaled = vector / peak
+    norm = float(np.linalg.norm(scaled))
+    return scaled / norm, peak * norm
+
+
 def positive_int(name: str, value: object) -> int:
     """Return ``value`` as an int >= 1 (booleans are refused)."""
     if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:

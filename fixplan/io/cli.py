@@ -765,7 +765,7 @@ def _run_push(args: argparse.Namespace) -> tuple[int, str]:
             duration=push_file.duration, steps=push_file.steps,
             start_overlap=push_file.start_overlap, progress=_Progress("pushing", not args.quiet),
         )  # fmt: skip
-    except GeometryError as exc:  # (a start the file's values allow one by one)
+    except GeometryError as exc:  # (a start, or a path, the file's values allow one by one)
         raise InvalidArgumentError(f"{args.file}: pusher: {exc}") from None
     if args.report is not None:
         written = write_push_report(args.report, push_file, trajectory)

@@ -189,6 +189,8 @@ class _Translations:
         if side * turn(far) >= 0.0:
             return None
         start = math.atan2(velocity @ tangent, push)
+        if side * turn(start) < 0.0:  # (then the force along the edge is not on this side)
+            return None
         angle = brentq(turn, min(far, start), max(far, start), xtol=ANGLE_XTOL,
                        rtol=4 * np.finfo(float).eps)  # fmt: skip
         return (math.cos(angle) * normal + math.sin(angle) * tangent) * push / math.cos(angle)

@@ -99,7 +99,7 @@ class LinePusher(_PathFollower):
             direction = validation.finite_array("normal", self.normal, shape=(2,))
             if not np.any(direction):
                 raise InvalidArgumentError("normal must be a nonzero 2-vector")
-        direction = direction / np.linalg.norm(direction)
+        direction = validation.unit_vector(direction)[0]
         direction.setflags(write=False)
         object.__setattr__(self, "normal", direction)
 

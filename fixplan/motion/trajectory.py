@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fixplan import validation
-from fixplan.errors import GeometryError, InvalidArgumentError, ModelError
+from fixplan.errors import ConvergenceError, GeometryError, InvalidArgumentError
 from fixplan.motion.line_contact import line_push_step
 from fixplan.motion.outline import Outline
 from fixplan.motion.pushers import LinePusher, PointPusher
@@ -36,6 +36,10 @@ from fixplan.motion.pushing import PushStep, push_step
 
 #: The pusher counts as touching the outline within this fraction of the part's size.
 TOUCH_RTOL = 1e-9
+
+#: A point of the part that enters a flat pusher's strip through its side more than this
+#: fraction of the part's size behind the face has reached around the pusher to its back.
+BEHIND_FACE = 1e-6
 
 #: Bisection steps that find the touching instant, or a new contact, within a step (to 2**-50
 #: of the step).
@@ -125,7 +129,9 @@ def push(
     start with the cylinder up to 3.4 mm into the part). An overlapping pusher touches the part
     from the start and keeps its overlap, pushing as if set back along its normal by it: a round
     one at the outline point nearest its centre (so its overlap is below its radius, the centre
-    outside), a flat one with its face that far behind it.
+    outside), a flat one with its face that far behind it. A part whose outline reaches around
+    an end of a flat pusher to its back raises :class:`~fixplan.errors.GeometryError` (only the
+    face is modelled).
     """
     if not isinstance(shape, Outline):
         raise InvalidArgumentError(f"shape must be an Outline, got {type(shape).__name__}")
@@ -259,7 +265,7 @@ class _FaceContact:
     def __init__(self, surface, shape: Outline, pusher: LinePusher):
         self.surface, self.shape, self.pusher = surface, shape, pusher
         size = float(np.abs(shape.vertices).max()) if len(shape.vertices) else shape.radius
-        self.tolerance = TOUCH_RTOL * size
+        self.size, self.tolerance = size, TOUCH_RTOL * size
         self.deepest_start = math.inf  # (any overlap along the normal is a set-back)
         #: How far behind the pusher the face acts [m]: a start's overlap (:meth:`start`).
         self.set_back = 0.0
@@ -334,26 +340,51 @@ class _FaceContact:
                     high = middle
                 else:
                     low = middle
-            pose, t = self._midpoint(pose, t, low, state), t + low
-            state = self.state(pose, t)
-        raise ModelError(  # pragma: no cover - the mechanics lift the points they leave
+            before = pose
+            pose = self._midpoint(before, t, low, state)
+            event = self.state(pose, t + low)
+            if event.keys == state.keys:
+                # The new point is not in the strip at the event: it comes in through a side of
+                # the strip. Level with the face, a corner passing an end of the face: step past
+                # the instant. Far below it, a part of the outline reaching around an end of the
+                # pusher to its back, which the face contact does not model.
+                pose, low = _compose(before, state.step.twist, high), high
+                if self._dip(pose, t + high, state.keys) < -BEHIND_FACE * self.size:
+                    x, y = self.pusher.position(t + high)
+                    raise GeometryError(
+                        f"at t = {t + high:.6g} s the part reaches around an end of the "
+                        f"{self.describe()[0]} at ({x:g}, {y:g}) m to its back, which a flat "
+                        "pusher's contact does not model (only its face pushes): start it "
+                        "elsewhere, or make its face wider"
+                    )
+                event = self.state(pose, t + high)
+            state, t = event, t + low
+        raise ConvergenceError(
             f"more than {EVENTS_PER_STEP} new contacts within one step at t = {t} s: the contact "
             "modes cycle without a consistent motion"
         )
 
     def _midpoint(self, pose: np.ndarray, t: float, time: float, state: _State):
         """The pose after ``time`` [s] by the midpoint rule, put back onto the face along its
-        normal while it presses (the integration's error moves the contact off it); ``None`` when a new point of the part reaches the face
-        by the half step or the end (the step of one pressing point holds only until then)."""
+        normal while it presses (the integration's error moves the contact off it); ``None``
+        when a new point of the part reaches the face by the half step or the end (the step of
+        one pressing point holds only until then)."""
         half = _compose(pose, state.step.twist, time / 2)
         if self._dip(half, t + time / 2, state.keys) < -self.tolerance / 2:
             return None
         midpoint = self.state(half, t + time / 2)
+        if midpoint.step.mode == "separated":
+            # The pressing point left the strip by the half step (the part turns off an end of
+            # the face): the step keeps the motion of its start, and the next one finds the
+            # contact where it is then. (A step at rest would leave the part where the face
+            # pushes on, and the face would pass through it.)
+            midpoint = state
         moved = _compose(pose, midpoint.step.twist, time)
         if self._dip(moved, t + time, state.keys) < -self.tolerance / 2:
             return None
-        if midpoint.step.mode != "separated":
-            moved[:2] -= self.gap(moved, t + time) * self.pusher.normal
+        gap = self.gap(moved, t + time)
+        if math.isfinite(gap):  # (inf: the part has left the strip; nothing to put back onto)
+            moved[:2] -= gap * self.pusher.normal
         return moved
 
     def _dip(self, pose: np.ndarray, t: float, keys: tuple) -> float:

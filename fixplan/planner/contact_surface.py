@@ -23,6 +23,7 @@ from fixplan.errors import FixplanError, InvalidArgumentError
 from fixplan.planner.contact_models import contact_models
 from fixplan.planner.problem import Contact
 from fixplan.surface.sphere import circle, fibonacci_sphere
+from fixplan.validation import unit_vector
 
 COMPONENTS = ("fx", "fy", "fz", "mx", "my", "mz")
 _OPTIONS = {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9}
@@ -117,7 +118,7 @@ class ContactSetSurface:
         direction = _vector("twist", twist, len(self.subspace))
         if not np.any(direction):
             return 0.0
-        unit, size = _unit(direction)  # (h is homogeneous: the solver sees a unit twist)
+        unit, size = unit_vector(direction)  # (h is homogeneous: the solver sees a unit twist)
         self._direction.value = unit
         self._solve(self._support)
         return float(self._support.value) * size
@@ -133,7 +134,7 @@ class ContactSetSurface:
         if not np.any(wrench):
             return np.full(len(self.subspace), np.nan), float("inf")
         # (The gauge is homogeneous: the solver sees the load at the scale of the axis extents.)
-        unit, size = _unit(wrench / self._units)
+        unit, size = unit_vector(wrench / self._units)
         self._direction.value = unit * self._units
         try:
             self._solve(self._gauge)
@@ -187,14 +188,6 @@ class ContactSetSurface:
             load[index] = direction * self._units[index]
             points.append(load[index] * self.safety_factor(load))
         return np.array(points)
-
-
-def _unit(vector: np.ndarray) -> tuple[np.ndarray, float]:
-    """``vector`` (nonzero) as a unit vector and its norm, without overflow or underflow."""
-    peak = float(np.max(np.abs(vector)))
-    scaled = vector / peak
-    norm = float(np.linalg.norm(scaled))
-    return scaled / norm, peak * norm
 
 
 def _vector(name: str, value, size: int) -> np.ndarray:
