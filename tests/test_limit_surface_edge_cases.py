@@ -159,3 +159,27 @@ def test_friction_forces_where_the_arithmetic_underflows_are_refused(mu, normal_
     load = np.array([0.15, 0.1, 0.001])
     assert tiny.safety_factor(1e-100 * load) == pytest.approx(unit.safety_factor(load), rel=1e-12)
     np.testing.assert_allclose(tiny.motion(1e-100 * load), unit.motion(load), rtol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "field",
+    [pressure.disk(0.01), pressure.rectangle(0.02, 0.01), pressure.points([[0, 0], [0.01, 0], [0, 0.01]]),
+     pressure.from_function(pressure.disk(0.01), lambda x, y: 1.0 + 50.0 * x)],
+    ids=["disk", "rectangle", "points", "function"],
+)  # fmt: skip
+def test_the_inverse_map_is_homogeneous_for_loads_of_any_finite_size(field):
+    # Loads of 1e308 N gave NaN (ZeroDivisionError for function fields), 5e-324 N NaN motions.
+    surface = LimitSurface(field, mu=0.3, normal_force=20.0)
+    load = np.array([1.0, 0.7, 0.02])
+    motion, safety = surface.motion_and_safety_factor(load)
+    for scale in (1e308 / 1.01, 1e200, 1e-300):
+        scaled_motion, scaled_safety = surface.motion_and_safety_factor(scale * load)
+        assert scaled_safety * scale == pytest.approx(safety, rel=1e-14)
+        np.testing.assert_allclose(scaled_motion, motion, atol=1e-13)
+    tiny = np.array([5e-324, 0.0, 0.0])  # (its safety factor is beyond the floats)
+    batch = np.vstack([1e308 * np.ones(3), load, tiny, np.zeros(3)])
+    safeties = surface.safety_factor(batch)
+    assert np.isfinite(safeties[0]) and safeties[0] > 0.0
+    assert safeties[1] == pytest.approx(safety, rel=1e-14)
+    assert safeties[2] == np.inf and safeties[3] == np.inf
+    np.testing.assert_allclose(surface.motion(tiny), surface.motion([1.0, 0.0, 0.0]), atol=1e-13)

@@ -302,6 +302,25 @@ class LimitSurface:
 
     def _inverse(self, load):
         loads, single, zero = _vectors("load", load)
+        if single:
+            x, y, z = loads[0].tolist()
+            peaks = max(abs(x), abs(y), abs(z))
+            ordinary = peaks == 0.0 or _SMALLEST_LOAD < peaks < _LARGEST_LOAD
+        else:
+            peaks = np.max(np.abs(loads), axis=1)
+            ordinary = np.all((peaks == 0.0) | ((peaks > _SMALLEST_LOAD) & (peaks < _LARGEST_LOAD)))
+        if ordinary:
+            return self._scaled_inverse(loads, single, zero)
+        # Loads scaled by powers of two (exactly) to a largest entry in [0.5, 1): s(c L) =
+        # s(L) / c and the motion does not change (1e308 N gave NaN, 5e-324 N a NaN motion).
+        exponents = np.frexp(np.atleast_1d(peaks))[1]
+        loads = np.ldexp(loads, -exponents[:, None])
+        safety, twists, single = self._scaled_inverse(loads, single, zero)
+        with np.errstate(over="ignore"):  # (a safety factor beyond the floats is inf)
+            return np.ldexp(safety, -exponents), twists, single
+
+    def _scaled_inverse(self, loads, single, zero):
+        """:meth:`_inverse` of ``loads`` ``(K, 3)`` whose largest entries are about 1."""
         if self._shape is not None:
             # Frictionless: only the load 0 is held; the motion is the limit mu -> 0+.
             safety = np.where(np.any(loads != 0.0, axis=1), 0.0, np.inf)
@@ -437,6 +456,11 @@ class LimitSurface:
         loads = directions * self._units
         loads = loads * self._inverse(loads)[0][:, None]
         return loads / self._units if normalized else loads
+
+
+#: Loads whose largest entry [N, N m] lies outside these are scaled before the inverse map
+#: (its normalisations by the surface's extents, down to 1e-109, would overflow or underflow).
+_SMALLEST_LOAD, _LARGEST_LOAD = 2.0**-500, 2.0**500
 
 
 def _vectors(name: str, value: object) -> tuple[np.ndarray, bool, int | None]:
