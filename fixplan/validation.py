@@ -20,6 +20,8 @@ def finite_scalar(name: str, value: object) -> float:
         number = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError) as exc:
         raise InvalidArgumentError(f"{name} must be a real number, got {value!r}") from exc
+    except OverflowError as exc:  # (an int beyond the floats)
+        raise InvalidArgumentError(f"{name} must be finite, got an integer beyond 1e308") from exc
     if not math.isfinite(number):
         raise InvalidArgumentError(f"{name} must be finite, got {number!r}")
     return number
@@ -61,9 +63,9 @@ def finite_array(name: str, value: object, *, shape: tuple[int | None, ...]) -> 
     """Return ``value`` as a read-only float array of ``shape`` (``None`` = any length)."""
     try:
         array = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:
         raise InvalidArgumentError(
-            f"{name} must be an array of real numbers, got {value!r}"
+            f"{name} must be an array of finite real numbers, got {value!r}"
         ) from exc
     expected = "(" + ", ".join("n" if n is None else str(n) for n in shape) + ")"
     if array.ndim != len(shape) or any(
@@ -80,9 +82,9 @@ def vector_batch(name: str, value: object, *, width: int) -> tuple[np.ndarray, b
     """Return ``value`` as a ``(K, width)`` float array and whether it was a single vector."""
     try:
         array = np.asarray(value, dtype=float)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:
         raise InvalidArgumentError(
-            f"{name} must be an array of real numbers, got {value!r}"
+            f"{name} must be an array of finite real numbers, got {value!r}"
         ) from exc
     single = array.ndim == 1
     if single:
@@ -111,3 +113,26 @@ def callable_argument(name: str, value: object) -> Callable:
     if not callable(value):
         raise InvalidArgumentError(f"{name} must be a function of (x, y), got {value!r}")
     return value
+
+
+def field_values(name: str, function: Callable, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``function(x, y)`` of a user's field ``name`` at the points ``x``, ``y`` (arrays of one
+    shape) as finite floats of that shape: one value per point, or one for all."""
+    try:
+        values = np.asarray(function(x, y), dtype=float)
+        return_shape = np.broadcast_shapes(values.shape, np.shape(x))
+    except InvalidArgumentError:  # (from a function of fixplan's that checks its own values)
+        raise
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise InvalidArgumentError(
+            f"{name}(x, y) must return real numbers, one per point of the arrays x and y of shape "
+            f"{np.shape(x)} (or one for all): {exc}"
+        ) from exc
+    if return_shape != np.shape(x):
+        raise InvalidArgumentError(
+            f"{name}(x, y) returned shape {values.shape} for points of shape {np.shape(x)}"
+        )
+    values = np.broadcast_to(values, np.shape(x))
+    if not np.all(np.isfinite(values)):
+        raise InvalidArgumentError(f"{name}(x, y) must be finite over the whole patch")
+    return values

@@ -528,7 +528,7 @@ def _api_inputs():
         "not a field": (lambda: LimitSurface("disk", mu=0.5), ["field", "pressure field"]),
         "negative friction function": (
             lambda: LimitSurface(pressure.points([[0, 0], [1, 0]]), mu=lambda x, y: x - 5.0),
-            ["mu(x, y)", ">= 0"],
+            ["mu(x, y)", "from 0 to 100"],
         ),
         "combine nothing": (lambda: LimitSurface.combine([]), ["LimitSurface"]),
         "combine a non-surface": (lambda: LimitSurface.combine([field]), ["LimitSurface"]),

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from fixplan import FixplanError, GeometryError, InvalidArgumentError, pressure
+from fixplan import FixplanError, GeometryError, InvalidArgumentError, LimitSurface, pressure
 
 R = 0.02  # disk radius [m]
 S = 0.6  # inner radius / radius of the annulus
@@ -579,7 +579,32 @@ def _inputs():
         "negative friction function": (
             lambda: disk.center_of_pressure(mu=lambda x, y: x - 1.0),
             InvalidArgumentError,
-            ["mu(x, y)", ">= 0"],
+            ["mu(x, y)", "from 0 to 100"],
+        ),
+        "friction function above the largest mu": (
+            lambda: LimitSurface(disk, mu=lambda x, y: 1e300 + 0.0 * x),
+            InvalidArgumentError,
+            ["mu(x, y)", "from 0 to 100"],
+        ),
+        "friction function of the wrong shape": (
+            lambda: LimitSurface(disk, mu=lambda x, y: np.ones(3)),
+            InvalidArgumentError,
+            ["mu(x, y) must return real numbers, one per point"],
+        ),
+        "pressure function of text": (
+            lambda: LimitSurface(pressure.from_function(disk, lambda x, y: "high"), mu=0.3),
+            InvalidArgumentError,
+            ["p(x, y) must return real numbers"],
+        ),
+        "radius an integer beyond the floats": (
+            lambda: pressure.disk(10**400),
+            InvalidArgumentError,
+            ["radius must be finite", "beyond 1e308"],
+        ),
+        "vertices with an integer beyond the floats": (
+            lambda: pressure.polygon([[0, 0], [10**400, 0], [0, 1]]),
+            InvalidArgumentError,
+            ["vertices must be an array of finite real numbers"],
         ),
     }
 

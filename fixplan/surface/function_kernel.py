@@ -351,12 +351,7 @@ def _field_values(name: str, function: Field | None, points: np.ndarray) -> np.n
     """``function(x, y)`` at ``points`` ``(n, 2)`` (1 when ``None``), checked finite."""
     if function is None:
         return np.ones(len(points))
-    values = np.broadcast_to(
-        np.asarray(function(points[:, 0], points[:, 1]), dtype=float), (len(points),)
-    )
-    if not np.all(np.isfinite(values)):
-        raise InvalidArgumentError(f"{name}(x, y) must be finite near the patch")
-    return values
+    return validation.field_values(name, function, points[:, 0], points[:, 1])
 
 
 @dataclass(frozen=True, slots=True)

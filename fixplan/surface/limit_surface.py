@@ -59,7 +59,7 @@ from fixplan.surface.pressure import (
 )
 from fixplan.surface.rules import triangle_rule
 from fixplan.surface.sphere import circle, fibonacci_sphere
-from fixplan.tolerances import CONTAINMENT_RTOL, MIN_FRICTION_FORCE, QUADRATURE_RTOL
+from fixplan.tolerances import CONTAINMENT_RTOL, MAX_MU, MIN_FRICTION_FORCE, QUADRATURE_RTOL
 
 #: Gauss order per triangle of the far-field rule of polygons (exact to machine precision for
 #: centres of rotation beyond FAR_FIELD_RADII patch radii).
@@ -570,10 +570,11 @@ def _varying_friction_kernel(field: PressureField, mu: Callable) -> SupportKerne
 
     def local_mu(x, y):
         xy = pose.apply(np.column_stack([np.ravel(x), np.ravel(y)]))
-        values = np.asarray(mu(xy[:, 0], xy[:, 1]), dtype=float)
-        values = np.broadcast_to(values, (len(xy),)).reshape(np.shape(x))
-        if not np.all(np.isfinite(values)) or np.any(values < 0.0):
-            raise InvalidArgumentError("mu(x, y) must be finite and >= 0 over the whole patch")
+        values = validation.field_values("mu", mu, xy[:, 0], xy[:, 1]).reshape(np.shape(x))
+        if np.any(values < 0.0) or np.any(values > MAX_MU):
+            raise InvalidArgumentError(
+                f"mu(x, y) must be from 0 to {MAX_MU:g} over the whole patch"
+            )
         return values
 
     if isinstance(field, PointsField):

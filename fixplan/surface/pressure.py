@@ -39,6 +39,7 @@ from fixplan.tolerances import (
     MAX_ANNULUS_RATIO,
     MAX_ASPECT_RATIO,
     MAX_LENGTH,
+    MAX_MU,
     MIN_PATCH_LENGTH,
     MIN_POINT_GAP_RATIO,
     MIN_WEIGHT_RATIO,
@@ -128,9 +129,9 @@ class PressureField(ABC):
 
 def friction_values(mu: Callable, points: np.ndarray) -> np.ndarray:
     """Evaluate ``mu(x, y)`` at ``points`` and check that it is finite and >= 0."""
-    values = np.broadcast_to(np.asarray(mu(points[:, 0], points[:, 1]), dtype=float), len(points))
-    if not np.all(np.isfinite(values)) or np.any(values < 0.0):
-        raise InvalidArgumentError("mu(x, y) must be finite and >= 0 over the whole patch")
+    values = validation.field_values("mu", mu, points[:, 0], points[:, 1])
+    if np.any(values < 0.0) or np.any(values > MAX_MU):
+        raise InvalidArgumentError(f"mu(x, y) must be from 0 to {MAX_MU:g} over the whole patch")
     if not np.any(values > 0.0):
         raise InvalidArgumentError("mu(x, y) is zero over the whole patch: there is no friction")
     return values
@@ -271,10 +272,8 @@ class FunctionField(PressureField):
 
     def pressure(self, points: np.ndarray) -> np.ndarray:
         """Relative pressure at local ``points`` ``(n, 2)``, checked finite and >= 0."""
-        values = np.broadcast_to(
-            np.asarray(self.function(points[:, 0], points[:, 1]), dtype=float), len(points)
-        )
-        if not np.all(np.isfinite(values)) or np.any(values < 0.0):
+        values = validation.field_values("p", self.function, points[:, 0], points[:, 1])
+        if np.any(values < 0.0):
             raise InvalidArgumentError("p(x, y) must be finite and >= 0 over the whole patch")
         return values
 
