@@ -115,9 +115,12 @@ def callable_argument(name: str, value: object) -> Callable:
     return value
 
 
-def field_values(name: str, function: Callable, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+def field_values(
+    name: str, function: Callable, x: np.ndarray, y: np.ndarray, where: str = "over the patch"
+) -> np.ndarray:
     """``function(x, y)`` of a user's field ``name`` at the points ``x``, ``y`` (arrays of one
-    shape) as finite floats of that shape: one value per point, or one for all."""
+    shape) as finite floats of that shape: one value per point, or one for all (``where``: the
+    points in words, for the error)."""
     try:
         values = np.asarray(function(x, y), dtype=float)
         return_shape = np.broadcast_shapes(values.shape, np.shape(x))
@@ -134,5 +137,5 @@ def field_values(name: str, function: Callable, x: np.ndarray, y: np.ndarray) ->
         )
     values = np.broadcast_to(values, np.shape(x))
     if not np.all(np.isfinite(values)):
-        raise InvalidArgumentError(f"{name}(x, y) must be finite over the whole patch")
+        raise InvalidArgumentError(f"{name}(x, y) must be finite {where}")
     return values

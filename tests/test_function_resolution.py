@@ -106,3 +106,10 @@ def test_the_disagreement_is_of_the_order_of_the_error_of_the_support_function(s
     disagreement = coarse.rule_disagreement()
     assert disagreement > QUADRATURE_RTOL
     assert disagreement / 3.0 < error < 3.0 * disagreement
+
+
+def test_a_friction_function_out_of_range_around_a_polygon_is_refused_saying_where():
+    # Positive on the rectangle, negative 3 patch radii to its left, where the rules about a
+    # centre of rotation near the polygon evaluate it (on triangles that leave the polygon).
+    with pytest.raises(InvalidArgumentError, match="up to 4 patch radii around it"):
+        LimitSurface(RECTANGLE, mu=lambda x, y: 0.5 + 0.2 * x / R, normal_force=1.0)

@@ -347,11 +347,19 @@ def _ray_nodes(rays: _Rays, centers: np.ndarray, rule: tuple[np.ndarray, np.ndar
     )
 
 
+#: Where the rules evaluate ``p`` and ``mu``, in words (for errors).
+SAMPLED = (
+    "where the limit surface's quadrature evaluates it: on the patch and, for a polygon, up to "
+    f"{FAR_FIELD_RADII:g} patch radii around it (the rules about a centre of rotation near a "
+    "polygon integrate over triangles that leave it)"
+)
+
+
 def _field_values(name: str, function: Field | None, points: np.ndarray) -> np.ndarray:
     """``function(x, y)`` at ``points`` ``(n, 2)`` (1 when ``None``), checked finite."""
     if function is None:
         return np.ones(len(points))
-    return validation.field_values(name, function, points[:, 0], points[:, 1])
+    return validation.field_values(name, function, points[:, 0], points[:, 1], SAMPLED)
 
 
 @dataclass(frozen=True, slots=True)
@@ -512,8 +520,8 @@ class FunctionKernel(SupportKernel):
         far_offsets = np.concatenate([[0], np.cumsum([len(r[1]) for r in rules])])
         points = np.concatenate([r[0] for r in rules])
         measure = np.concatenate([r[1] for r in rules]) * np.repeat(weights, np.diff(far_offsets))
-        pressure = _field_values("pressure", self.pressure, points)
-        friction = _field_values("friction", self.friction, points)
+        pressure = _field_values("p", self.pressure, points)
+        friction = _field_values("mu", self.friction, points)
         if np.any(pressure < 0.0) or np.any(friction < 0.0):
             raise InvalidArgumentError("pressure and friction must be >= 0 on the patch")
         normal_force = float(measure @ pressure)
@@ -654,8 +662,8 @@ class FunctionKernel(SupportKernel):
         centers = np.column_stack([-vy / w, vx / w])
         pair, points, area, rho, unit = self._near_nodes(centers, pair_region)
         values = (
-            _field_values("pressure", self.pressure, points)
-            * _field_values("friction", self.friction, points)
+            _field_values("p", self.pressure, points)
+            * _field_values("mu", self.friction, points)
             * area
             * (lay.weights[pair_region] / self.normal_force)[pair]
         )

@@ -59,7 +59,13 @@ from fixplan.surface.pressure import (
 )
 from fixplan.surface.rules import triangle_rule
 from fixplan.surface.sphere import circle, fibonacci_sphere
-from fixplan.tolerances import CONTAINMENT_RTOL, MAX_MU, MIN_FRICTION_FORCE, QUADRATURE_RTOL
+from fixplan.tolerances import (
+    CONTAINMENT_RTOL,
+    FAR_FIELD_RADII,
+    MAX_MU,
+    MIN_FRICTION_FORCE,
+    QUADRATURE_RTOL,
+)
 
 #: Gauss order per triangle of the far-field rule of polygons (exact to machine precision for
 #: centres of rotation beyond FAR_FIELD_RADII patch radii).
@@ -566,16 +572,16 @@ def _regions(shape: DiskField | PolygonField) -> tuple:
 
 def _varying_friction_kernel(field: PressureField, mu: Callable) -> SupportKernel:
     """Kernel of ``mu(x, y) * p`` (unit normal force) for position-dependent friction."""
+    from fixplan.surface.function_kernel import SAMPLED, FunctionKernel
+
     pose = field.pose
 
     def local_mu(x, y):
         xy = pose.apply(np.column_stack([np.ravel(x), np.ravel(y)]))
-        values = validation.field_values("mu", mu, xy[:, 0], xy[:, 1]).reshape(np.shape(x))
+        values = validation.field_values("mu", mu, xy[:, 0], xy[:, 1], SAMPLED)
         if np.any(values < 0.0) or np.any(values > MAX_MU):
-            raise InvalidArgumentError(
-                f"mu(x, y) must be from 0 to {MAX_MU:g} over the whole patch"
-            )
-        return values
+            raise InvalidArgumentError(f"mu(x, y) must be from 0 to {MAX_MU:g} {SAMPLED}")
+        return values.reshape(np.shape(x))
 
     if isinstance(field, PointsField):
         friction = field.weights * local_mu(field.xy[:, 0], field.xy[:, 1])
@@ -592,8 +598,6 @@ def _varying_friction_kernel(field: PressureField, mu: Callable) -> SupportKerne
             friction = friction[rubbing]
         points = field.xy[rubbing] if np.any(rubbing) else field.xy
         return PointSetKernel(pose.apply(points), friction, discrete=True)
-    from fixplan.surface.function_kernel import FunctionKernel
-
     pressure = None
     if isinstance(field, DiskField):
         radius = field.radius_m
@@ -633,6 +637,7 @@ def _resolved(kernel: SupportKernel, what: str) -> SupportKernel:
             "accepted), and its answers would be off by about as much. Where it jumps or has a "
             "kink (a step in pressure, two materials), describe each smooth region as its own "
             "patch and sum them with LimitSurface.combine; sample a narrow peak on a "
-            "pressure.grid"
+            "pressure.grid. On a polygon it must also extend smoothly to "
+            f"{FAR_FIELD_RADII:g} patch radii around it, where the rules evaluate it"
         )
     return kernel
