@@ -326,7 +326,8 @@ class LimitSurface:
             return np.ldexp(safety, -exponents), twists, single
 
     def _scaled_inverse(self, loads, single, zero):
-        """:meth:`_inverse` of ``loads`` ``(K, 3)`` whose largest entries are about 1."""
+        """:meth:`_inverse` of ``loads`` ``(K, 3)`` whose largest entries lie within 2^±500 (or
+        are 0: a zero load)."""
         if self._shape is not None:
             # Frictionless: only the load 0 is held; the motion is the limit mu -> 0+.
             safety = np.where(np.any(loads != 0.0, axis=1), 0.0, np.inf)
