@@ -244,6 +244,8 @@ def test_a_frictionless_support_and_a_model_without_motion_are_refused():
         push_step(frictionless, contact=[-0.05, 0], normal=[1, 0], velocity=[1, 0], mu=0.3)
     with pytest.raises(InvalidArgumentError, match="normal"):
         push_step(DISK, contact=[-0.05, 0], normal=[0, 0], velocity=[1, 0], mu=0.3)
+    with pytest.raises(InvalidArgumentError, match="contact must lie within 1000 m"):
+        push_step(DISK, contact=[1e300, 0], normal=[1, 0], velocity=[1, 0], mu=0.3)
 
 
 @pytest.mark.parametrize(
