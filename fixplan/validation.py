@@ -11,7 +11,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from fixplan.errors import InvalidArgumentError
+from fixplan.errors import GeometryError, InvalidArgumentError
+from fixplan.tolerances import MAX_LENGTH
 
 
 def finite_scalar(name: str, value: object) -> float:
@@ -116,11 +117,16 @@ def callable_argument(name: str, value: object) -> Callable:
 
 
 def field_values(
-    name: str, function: Callable, x: np.ndarray, y: np.ndarray, where: str = "over the patch"
+    name: str,
+    function: Callable,
+    x: np.ndarray,
+    y: np.ndarray,
+    where: str = "over the patch",
+    within: tuple[float, float] | None = None,
 ) -> np.ndarray:
     """``function(x, y)`` of a user's field ``name`` at the points ``x``, ``y`` (arrays of one
     shape) as finite floats of that shape: one value per point, or one for all (``where``: the
-    points in words, for the error)."""
+    points in words, for the error), each ``within`` ``(lowest, highest)`` where given."""
     try:
         values = np.asarray(function(x, y), dtype=float)
         return_shape = np.broadcast_shapes(values.shape, np.shape(x))
@@ -138,4 +144,19 @@ def field_values(
     values = np.broadcast_to(values, np.shape(x))
     if not np.all(np.isfinite(values)):
         raise InvalidArgumentError(f"{name}(x, y) must be finite {where}")
+    if within is not None and (np.any(values < within[0]) or np.any(values > within[1])):
+        raise InvalidArgumentError(
+            f"{name}(x, y) must be from {within[0]:g} to {within[1]:g} {where}"
+        )
+    return values
+
+
+def coordinates(name: str, values: np.ndarray) -> np.ndarray:
+    """``values`` [m], checked within ``MAX_LENGTH`` of the origin (areas, moments and
+    speeds of farther ones overflow)."""
+    largest = float(np.max(np.abs(values), initial=0.0))
+    if largest > MAX_LENGTH:
+        raise GeometryError(
+            f"{name} must lie within {MAX_LENGTH:g} m of the origin, got {largest!r}"
+        )
     return values

@@ -53,7 +53,6 @@ from scipy.optimize import brentq
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError, ModelError
 from fixplan.models.ellipsoid import Ellipsoid, FittedEllipsoid
-from fixplan.tolerances import MAX_LENGTH
 
 MODES = ("sticking", "sliding-left", "sliding-right", "separated")
 
@@ -241,10 +240,7 @@ class _Geometry:
                 "accelerates it (give the support friction)"
             )
         contact = _pair("contact", contact)
-        if max(abs(contact[0]), abs(contact[1])) > MAX_LENGTH:  # (1e300 m gave a NaN step)
-            raise InvalidArgumentError(
-                f"contact must lie within {MAX_LENGTH:g} m of the part's origin, got {contact}"
-            )
+        validation.coordinates("contact", np.array(contact))  # (1e300 m gave a NaN step)
         nx, ny = _pair("normal", normal)
         length = math.hypot(nx, ny)
         if length == 0.0:

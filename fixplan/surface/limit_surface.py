@@ -255,9 +255,7 @@ class LimitSurface:
         The kernels square speeds: twists far from unit size (beyond about 1e±154) would
         underflow or overflow there, though the load is homogeneous of degree 0 in the twist,
         the support of degree 1 and its Hessian of degree -1."""
-        reach = np.array([1.0, 1.0, self._kernel.size])
-        _, exponents = np.frexp(np.max(np.abs(twists) * reach, axis=1))
-        return np.ldexp(twists, -exponents[:, None]), exponents
+        return _binary_scaled(twists, np.array([1.0, 1.0, self._kernel.size]))
 
     def _trusted_support(self, twists: np.ndarray) -> np.ndarray:
         """:meth:`support` ``(K,)`` of finite twists ``(K, 3)`` from a caller that checked them
@@ -317,10 +315,9 @@ class LimitSurface:
             ordinary = np.all((peaks == 0.0) | ((peaks > _SMALLEST_LOAD) & (peaks < _LARGEST_LOAD)))
         if ordinary:
             return self._scaled_inverse(loads, single, zero)
-        # Loads scaled by powers of two (exactly) to a largest entry in [0.5, 1): s(c L) =
-        # s(L) / c and the motion does not change (1e308 N gave NaN, 5e-324 N a NaN motion).
-        exponents = np.frexp(np.atleast_1d(peaks))[1]
-        loads = np.ldexp(loads, -exponents[:, None])
+        # s(c L) = s(L) / c and the motion does not change (1e308 N gave NaN, 5e-324 N a NaN
+        # motion).
+        loads, exponents = _binary_scaled(loads, np.ones(3))
         safety, twists, single = self._scaled_inverse(loads, single, zero)
         with np.errstate(over="ignore"):  # (a safety factor beyond the floats is inf)
             return np.ldexp(safety, -exponents), twists, single
@@ -465,6 +462,14 @@ class LimitSurface:
         return loads / self._units if normalized else loads
 
 
+def _binary_scaled(vectors: np.ndarray, reach: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``vectors`` ``(K, 3)`` scaled by powers of two ``2^-e`` (exactly) so that the largest of
+    their entries times ``reach`` ``(3,)`` is in ``[0.5, 1)`` (a zero vector stays), and the
+    exponents ``e`` ``(K,)``."""
+    _, exponents = np.frexp(np.max(np.abs(vectors) * reach, axis=1))
+    return np.ldexp(vectors, -exponents[:, None]), exponents
+
+
 #: Loads whose largest entry [N, N m] lies outside these are scaled before the inverse map
 #: (its normalisations by the surface's extents, down to 1e-109, would overflow or underflow).
 _SMALLEST_LOAD, _LARGEST_LOAD = 2.0**-500, 2.0**500
@@ -579,9 +584,7 @@ def _varying_friction_kernel(field: PressureField, mu: Callable) -> SupportKerne
 
     def local_mu(x, y):
         xy = pose.apply(np.column_stack([np.ravel(x), np.ravel(y)]))
-        values = validation.field_values("mu", mu, xy[:, 0], xy[:, 1], SAMPLED)
-        if np.any(values < 0.0) or np.any(values > MAX_MU):
-            raise InvalidArgumentError(f"mu(x, y) must be from 0 to {MAX_MU:g} {SAMPLED}")
+        values = validation.field_values("mu", mu, xy[:, 0], xy[:, 1], SAMPLED, (0.0, MAX_MU))
         return values.reshape(np.shape(x))
 
     if isinstance(field, PointsField):

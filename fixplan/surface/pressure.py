@@ -123,15 +123,13 @@ class PressureField(ABC):
 
     def _placed(self, pose: Pose) -> PressureField:
         """The same field at ``pose``, whose offset must stay within ``MAX_LENGTH``."""
-        _coordinates("the field's placed origin", np.array(pose.offset))
+        validation.coordinates("the field's placed origin", np.array(pose.offset))
         return dataclasses.replace(self, pose=pose)
 
 
 def friction_values(mu: Callable, points: np.ndarray) -> np.ndarray:
-    """Evaluate ``mu(x, y)`` at ``points`` and check that it is finite and >= 0."""
-    values = validation.field_values("mu", mu, points[:, 0], points[:, 1])
-    if np.any(values < 0.0) or np.any(values > MAX_MU):
-        raise InvalidArgumentError(f"mu(x, y) must be from 0 to {MAX_MU:g} over the whole patch")
+    """Evaluate ``mu(x, y)`` at ``points`` and check that it is from 0 to ``MAX_MU``."""
+    values = validation.field_values("mu", mu, points[:, 0], points[:, 1], within=(0.0, MAX_MU))
     if not np.any(values > 0.0):
         raise InvalidArgumentError("mu(x, y) is zero over the whole patch: there is no friction")
     return values
@@ -327,17 +325,6 @@ def _patch_length(name: str, value) -> float:
     return length
 
 
-def _coordinates(name: str, values: np.ndarray) -> np.ndarray:
-    """``values`` [m], checked within ``MAX_LENGTH`` of the origin (areas and moments of
-    farther ones overflow)."""
-    largest = float(np.max(np.abs(values), initial=0.0))
-    if largest > MAX_LENGTH:
-        raise GeometryError(
-            f"{name} must lie within {MAX_LENGTH:g} m of the origin, got {largest!r}"
-        )
-    return values
-
-
 def rectangle(length: float, width: float) -> PolygonField:
     """Uniform pressure on a ``length`` x ``width`` [m] rectangle, long side along x, centred."""
     a = _patch_length("length", length) / 2.0
@@ -354,7 +341,7 @@ def polygon(vertices, *, centered: bool = True) -> PolygonField:
     the given coordinates are kept. Raises :class:`GeometryError` for self-intersecting or
     degenerate polygons.
     """
-    points = _coordinates(
+    points = validation.coordinates(
         "vertices", validation.finite_array("vertices", vertices, shape=(None, 2))
     )
     ccw = simple_polygon("vertices", points)
@@ -377,7 +364,7 @@ def points(xy, weights=None, *, centered: bool = True) -> PointsField:
     friction (use a point-contact model). With ``centered`` (default) the points are moved so that
     their centre of pressure is the origin.
     """
-    xy_array = _coordinates("xy", validation.finite_array("xy", xy, shape=(None, 2)))
+    xy_array = validation.coordinates("xy", validation.finite_array("xy", xy, shape=(None, 2)))
     if len(xy_array) == 0:
         raise InvalidArgumentError(
             "xy must hold at least two distinct loaded points (n >= 2), got an empty set"
@@ -471,8 +458,8 @@ def grid(x, y, values, *, centered: bool = True) -> GridField:
     Centres must be equally spaced and increasing. With ``centered`` (default) the map is moved
     so that its centre of pressure is the origin.
     """
-    xs = _coordinates("x", validation.finite_array("x", x, shape=(None,)))
-    ys = _coordinates("y", validation.finite_array("y", y, shape=(None,)))
+    xs = validation.coordinates("x", validation.finite_array("x", x, shape=(None,)))
+    ys = validation.coordinates("y", validation.finite_array("y", y, shape=(None,)))
     vals = validation.finite_array("values", values, shape=(len(ys), len(xs)))
     for name, axis in (("x", xs), ("y", ys)):
         steps = np.diff(axis)
