@@ -38,6 +38,15 @@ at rest. Without a load it stays at rest. With one, the load on the resting body
 the samples, and the instant it leaves the surface is found between them by root finding; the
 body starts to slide there (a load that leaves the surface and comes back between two samples
 goes unnoticed).
+
+**Point supports** (an exact surface's :attr:`~fixplan.LimitSurface.point_supports`) make
+facets, where ``h`` has kinks: a body can turn about one of them while it sticks
+(:mod:`fixplan.motion.support_pivot`). A second event finds where a point support comes to rest
+(below the stopping speed) while the body slides; where its friction can hold it, the body
+turns about it (its angle and rate integrated, the point still) until it stops or the point's
+friction gives out and it slips (the body slides on, that point starting at ``SLIP_START``
+times the stopping speed). A body that starts from rest by turning about a point (the minimiser
+of the convex problem on a facet) is found before the smooth start is solved for.
 """
 
 from __future__ import annotations
@@ -52,11 +61,20 @@ from scipy.optimize import brentq, root
 from fixplan import validation
 from fixplan.errors import ConvergenceError, InvalidArgumentError
 from fixplan.motion.forward_map import ForwardMap, forward_map
+from fixplan.motion.support_pivot import PointSupports, Turn, turn_from_rest, turning_twist
 from fixplan.tolerances import CONTAINMENT_RTOL, MAX_STEPS
 
 #: The body counts as stopped when its speed (with rotation counted at the radius of gyration)
 #: falls below this fraction of the run's speed scale.
 STOP_RTOL = 1e-9
+
+#: A point support that slips after a turn about it starts at this multiple of the stopping
+#: speed (its speed grows from 0 as its friction gives out, and the direction of its friction
+#: is the direction of that speed: from the stopping speed itself the integration turned it at
+#: every step and gave up). On a bar pushed sideways at one of its two support points (tests/
+#: test_support_pivot.py), against an integration of friction regularised below 1e-9 m/s: 10
+#: times, 2.5e-9 rad off after the slip; 100 times, 1.4e-8 rad; 1,000 times, 1.8e-7 rad.
+SLIP_START = 10.0
 
 #: Relative tolerance of the adaptive integration.
 INTEGRATION_RTOL = 1e-10
@@ -101,6 +119,9 @@ class Sliding:
         Every instant [s] at which the body came to rest (it may start again under a load).
     starts : tuple of float
         Every instant [s] at which a resting body started to slide (its load left the surface).
+    pivots : tuple of (float, float, int)
+        Every turn about a point support that stayed still: its start and end [s] and the
+        point's index in the surface's :attr:`~fixplan.LimitSurface.point_supports`.
     """
 
     t: np.ndarray
@@ -109,6 +130,7 @@ class Sliding:
     stopped: float | None
     stops: tuple[float, ...]
     starts: tuple[float, ...]
+    pivots: tuple[tuple[float, float, int], ...]
 
 
 def slide(
@@ -163,27 +185,18 @@ def slide(
         raise InvalidArgumentError(
             "twist0 must be nonzero without a load (a body at rest does not slide)"
         )
-    body = _Body(friction, np.array([mass, mass, inertia]), load)
+    supports = PointSupports.of(surface)
+    body = _Body(friction, np.array([mass, mass, inertia]), load, supports)
     start = np.concatenate([pose, _rotated(pose[2], twist)])
     scale = max(body.speed(start), float(friction.support(np.array([1.0, 0.0, 0.0]))) / mass
                 * duration)  # fmt: skip
-    stop_speed = STOP_RTOL * scale
-
-    def stopping(t, state):
-        return body.speed(state) - stop_speed
-
-    stopping.terminal = True
-    stopping.direction = -1
-    # Velocities to well below the stopping speed: a step that jumps across rest would
-    # otherwise bounce off it (friction reverses there) unseen by the event.
     gyration = np.sqrt(inertia / mass)
-    atol = np.array([*[INTEGRATION_RTOL * scale * max(duration, 1.0)] * 3,
-                     *(STOP_ATOL * stop_speed / np.array([1.0, 1.0, gyration]))])  # fmt: skip
+    run = _Run(body, STOP_RTOL * scale, INTEGRATION_RTOL * scale * max(duration, 1.0), gyration)
     grid = np.linspace(0.0, duration, int(samples) + 1)
-    times, states, stops, starts = [0.0], [start], [], []
-    t, state = 0.0, start
+    times, states, stops, starts, pivots = [0.0], [start], [], [], []
+    t, state, turn = 0.0, start, None
     while t < duration:
-        if not np.any(state[3:]):  # at rest until the load leaves the surface
+        if turn is None and not np.any(state[3:]):  # at rest until the load leaves the surface
             leave = body.leaving(t, state[:3], grid)
             rest = grid[(grid > t) & (grid <= (duration if leave is None else leave))]
             times += list(rest)
@@ -192,16 +205,21 @@ def slide(
                 break
             t = leave
             starts.append(t)
-        result = _integrate(body, (t, duration), state, grid[grid > t], stopping, atol)
-        # scipy returns lists, not arrays, when the run ends before the first sample.
-        times += list(np.asarray(result.t, dtype=float))
-        states += list(np.reshape(result.y, (len(state), -1)).T)
-        if not result.t_events[0].size:
+            turn = body.turn_from_rest(t, state[:3])
+        if turn is not None:
+            pivots.append([t, duration, turn.index])
+            segment_times, segment, ended = run.turning(turn, (t, duration), state, grid)
+        else:
+            segment_times, segment, ended = run.sliding((t, duration), state, grid)
+        times += segment_times
+        states += segment
+        if ended is None:
             break
-        t = float(result.t_events[0][0])
-        state = result.y_events[0][0].copy()
-        state[3:] = 0.0
-        stops.append(t)
+        if turn is not None:
+            pivots[-1][1] = ended[0]
+        t, state, turn = ended
+        if turn is None and not np.any(state[3:]):
+            stops.append(t)
         times.append(t)
         states.append(state)
     states = np.array(states)
@@ -215,52 +233,93 @@ def slide(
         stopped=(stops[-1] if stops else 0.0) if resting else None,
         stops=tuple(stops),
         starts=tuple(starts),
+        pivots=tuple((float(a), float(b), int(i)) for a, b, i in pivots),
     )
 
 
 def start_acceleration(surface, load, *, mass: float, inertia: float) -> np.ndarray:
     """The acceleration ``(ax, ay, α)`` [m/s², m/s², rad/s²] (body frame) of a body at rest under
     ``load`` ``(fx, fy, m)`` [N, N, N m]: the minimiser of the convex problem of the module
-    docstring, 0 when the load lies inside the limit surface.
+    docstring, 0 when the load lies inside the limit surface. Where it turns the body about a
+    point support (a facet: :mod:`fixplan.motion.support_pivot`), that turn's.
 
     Arguments as for :func:`slide`.
     """
     friction = forward_map(surface)
     masses = np.array([validation.positive_scalar("mass", mass),
                        validation.positive_scalar("inertia", inertia)])[[0, 0, 1]]  # fmt: skip
-    return _start(friction, masses, validation.finite_array("load", load, shape=(3,)))
+    load = validation.finite_array("load", load, shape=(3,))
+    supports = PointSupports.of(surface)
+    if supports is not None and friction.safety_factor(load) < 1.0 - CONTAINMENT_RTOL:
+        found = turn_from_rest(supports, friction, masses, load)
+        if found is not None:
+            _, turn, sense = found
+            return turn.acceleration(friction.load, load, 0.0, sense)[0] * turning_twist(
+                turn.point, 1.0
+            )
+    return _start(friction, masses, load)
 
 
 class _StiffError(Exception):
     """An integration took more than ``MAX_EVALUATIONS`` of the equations of motion."""
 
 
-def _integrate(body, span, state, samples, stopping, atol):
-    """``solve_ivp`` of ``body`` over ``span`` from ``state``: explicitly (RK45), and where that
-    takes more than ``MAX_EVALUATIONS`` (stiff), with LSODA, which switches to an implicit
-    method; :class:`~fixplan.errors.ConvergenceError` where that does too."""
+def _integrate(rate, span, state, samples, events, atol):
+    """``solve_ivp`` of ``rate(t, y)`` over ``span`` from ``state``: explicitly (RK45), and
+    where that takes more than ``MAX_EVALUATIONS`` (stiff), with LSODA, which switches to an
+    implicit method; :class:`~fixplan.errors.ConvergenceError` where that does too."""
     for method in ("RK45", "LSODA"):
         count = 0
 
-        def rate(t, y):
+        def counted(t, y):
             nonlocal count
             count += 1
             if count > MAX_EVALUATIONS:
                 raise _StiffError
-            return body.rate(t, y)
+            return rate(t, y)
 
         try:
-            return solve_ivp(rate, span, state, method=method, t_eval=samples, events=stopping,
-                             rtol=INTEGRATION_RTOL, atol=atol)  # fmt: skip
+            result = solve_ivp(counted, span, state, method=method, t_eval=samples,
+                               events=events, rtol=INTEGRATION_RTOL, atol=atol)  # fmt: skip
         except _StiffError:
             continue
+        if result.status >= 0:
+            return result
     raise ConvergenceError(
         f"slide: the motion from t = {span[0]:.6g} s took more than {MAX_EVALUATIONS:,} "
-        "evaluations of its equations with RK45 and with LSODA: its friction switches faster "
-        "than either can follow, as for a part on point supports that pivots about one of "
-        "them (the friction of that point flips at every step), which is not modelled yet. "
-        "Support the part on a patch, or shorten the duration to before the pivot"
+        "evaluations of its equations, or failed, with RK45 and with LSODA: its friction "
+        "switches faster than either can follow (as at a point contact of a ContactSetSurface, whose turns "
+        "about its points are not followed; a LimitSurface's point supports are). Support the "
+        "part on a patch, or shorten the duration"
     )
+
+
+def _terminal(function, direction: float):
+    """``function`` as a terminal event of ``solve_ivp`` crossing 0 in ``direction``."""
+    function.terminal = True
+    function.direction = direction
+    return function
+
+
+@dataclass(frozen=True, slots=True)
+class _Turning:
+    """A turn about the point support ``index`` (:class:`~fixplan.motion.support_pivot.Turn`)
+    in ``sense`` (±1), the point still at ``anchor`` ``(2,)`` [m] in the world."""
+
+    index: int
+    turn: Turn
+    sense: float
+    anchor: np.ndarray
+
+    def pose(self, angle: float) -> np.ndarray:
+        """The world pose of the centre of mass at the body's ``angle`` [rad]."""
+        x, y = self.anchor - _rotated(angle, np.array([*self.turn.point, 0.0]))[:2]
+        return np.array([x, y, angle])
+
+    def state(self, angle: float, rate: float) -> np.ndarray:
+        """The slide's state ``(pose, world velocity, rate)`` at ``angle`` and ``rate``."""
+        reach = _rotated(angle, np.array([*self.turn.point, 0.0]))
+        return np.array([*self.pose(angle), rate * reach[1], -rate * reach[0], rate])
 
 
 @dataclass(frozen=True, slots=True)
@@ -270,6 +329,7 @@ class _Body:
     friction: ForwardMap
     masses: np.ndarray  # (m, m, I)
     load: Callable | None
+    supports: PointSupports | None
 
     def speed(self, state: np.ndarray) -> float:
         """Speed [m/s] with rotation counted at the radius of gyration."""
@@ -314,6 +374,146 @@ class _Body:
         else:
             acceleration = np.zeros(3)
         return [*state[3:], *_rotated(state[2], acceleration)]
+
+    def turn_from_rest(self, t: float, pose: np.ndarray) -> _Turning | None:
+        """The turn about a point support in which the body resting at ``pose`` starts at
+        ``t`` [s], if it starts so (:func:`~fixplan.motion.support_pivot.turn_from_rest`)."""
+        if self.supports is None:
+            return None
+        found = turn_from_rest(self.supports, self.friction, self.masses, self.applied(t, pose))
+        return None if found is None else self._turning(pose, *found)
+
+    def turn_at(self, t: float, state: np.ndarray, index: int) -> _Turning | None:
+        """The turn about point support ``index``, now at rest in the sliding ``state``, where
+        its friction keeps it still (``None``: it slips on)."""
+        rate = float(state[5])
+        if rate == 0.0:
+            return None
+        turn = Turn(self.supports.points[index], self.supports.capacity(index), self.masses)
+        sense = float(np.sign(rate))
+        applied = self.applied(t, state[:3])
+        if not turn.sticks(turn.acceleration(self.friction.load, applied, rate, sense)[1]):
+            return None
+        return self._turning(state[:3], index, turn, sense)
+
+    @staticmethod
+    def _turning(pose: np.ndarray, index: int, turn: Turn, sense: float) -> _Turning:
+        anchor = pose[:2] + _rotated(pose[2], np.array([*turn.point, 0.0]))[:2]
+        return _Turning(index, turn, sense, anchor)
+
+
+@dataclass(frozen=True, slots=True)
+class _Run:
+    """The segments of a slide: sliding, or turning about a point support, each integrated
+    to its end (``stop_speed`` [m/s]; ``position_atol`` [m] and the radius of ``gyration``
+    [m] set the absolute tolerances)."""
+
+    body: _Body
+    stop_speed: float
+    position_atol: float
+    gyration: float
+
+    def sliding(self, span, state, grid) -> tuple[list, list, tuple | None]:
+        """Times and states of the body sliding from ``state`` over ``span``, and how the
+        segment ended: ``None`` at the end of ``span``, else ``(t, state, turn)``: at rest
+        (``turn`` ``None``, the velocities 0) or turning about a point support that came to
+        rest (a :class:`_Turning`)."""
+        body, stop_speed = self.body, self.stop_speed
+        # Velocities to well below the stopping speed: a step that jumps across rest would
+        # otherwise bounce off it (friction reverses there) unseen by the events.
+        velocity_atol = STOP_ATOL * stop_speed / np.array([1.0, 1.0, self.gyration])
+        atol = np.array([*[self.position_atol] * 3, *velocity_atol])
+        stopping = _terminal(lambda t, y: body.speed(y) - stop_speed, -1.0)
+        times, states, slipping = [], [], np.zeros(0, dtype=int)
+        if body.supports is not None:  # (a point that is still already: as when one stops)
+            speeds = body.supports.speeds(_rotated(-state[2], state[3:]))
+            index = int(np.argmin(speeds))
+            turning = body.turn_at(span[0], state, index) if speeds[index] <= stop_speed else None
+            if turning is not None:
+                return times, states, (span[0], turning.state(state[2], state[5]), turning)
+        while True:
+            events = [stopping]
+            if body.supports is not None:
+                events.append(_terminal(self._point_at_rest(slipping), -1.0))
+            result = _integrate(body.rate, span, state, grid[grid > span[0]], events, atol)
+            more_times, more_states = _samples(result, len(state))
+            times += more_times
+            states += more_states
+            hits = [(float(t[0]), k) for k, t in enumerate(result.t_events) if t.size]
+            if not hits:
+                return times, states, None
+            t, which = min(hits)
+            state = result.y_events[which][0].copy()
+            if which == 0:
+                state[3:] = 0.0
+                return times, states, (t, state, None)
+            speeds = body.supports.speeds(_rotated(-state[2], state[3:]))
+            speeds[slipping] = np.inf
+            index = int(np.argmin(speeds))
+            turning = body.turn_at(t, state, index)
+            if turning is not None:
+                return times, states, (t, turning.state(state[2], state[5]), turning)
+            # Its friction cannot keep it still: it slips through rest, not followed by the
+            # event again in this segment.
+            slipping = np.append(slipping, index)
+            span = (t, span[1])
+
+    def _point_at_rest(self, slipping: np.ndarray):
+        """The event of a point support (not among ``slipping``) coming to rest."""
+        speeds, stop_speed = self.body.supports.speeds, self.stop_speed
+
+        def event(t, y):
+            moving = speeds(_rotated(-y[2], y[3:]))
+            moving[slipping] = np.inf
+            return float(np.min(moving)) - stop_speed
+
+        return event
+
+    def turning(self, turning: _Turning, span, state, grid) -> tuple[list, list, tuple | None]:
+        """:meth:`sliding` for a body turning about a point support: its angle and rate
+        integrated, until it stops or the point slips (then ``turn`` is ``None``)."""
+        body, turn = self.body, turning.turn
+        reach = float(np.hypot(np.hypot(*turn.point), self.gyration))
+
+        def accelerated(t, y):
+            sense = float(np.sign(y[1])) or turning.sense
+            applied = body.applied(t, turning.pose(y[0]))
+            return turn.acceleration(body.friction.load, applied, y[1], sense)
+
+        def rate(t, y):
+            return [y[1], accelerated(t, y)[0]]
+
+        def slipping(t, y):
+            return float(np.hypot(*accelerated(t, y)[1])) - (1.0 + CONTAINMENT_RTOL) * turn.capacity
+
+        stopping = _terminal(lambda t, y: abs(y[1]) * reach - self.stop_speed, -1.0)
+        atol = np.array([self.position_atol / reach, STOP_ATOL * self.stop_speed / reach])
+        start = np.array([state[2], state[5]])
+        events = [stopping, _terminal(slipping, 1.0)]
+        result = _integrate(rate, span, start, grid[grid > span[0]], events, atol)
+        angles, samples = _samples(result, 2)
+        states = [turning.state(*y) for y in samples]
+        hits = [(float(t[0]), k) for k, t in enumerate(result.t_events) if t.size]
+        if not hits:
+            return angles, states, None
+        t, which = min(hits)
+        angle, rate_now = result.y_events[which][0]
+        if which == 0:
+            return angles, states, (t, turning.state(angle, 0.0), None)
+        # The point slips where its friction gives out, along the force it gave, reversed (the
+        # friction then goes on giving it), at SLIP_START times the stopping speed.
+        end = turning.state(angle, rate_now)
+        force = accelerated(t, [angle, rate_now])[1]
+        slip = -SLIP_START * self.stop_speed * force / np.hypot(*force)
+        end[3:5] += _rotated(angle, np.array([*slip, 0.0]))[:2]
+        return angles, states, (t, end, None)
+
+
+def _samples(result, width: int) -> tuple[list, list]:
+    """The times and states of a ``solve_ivp`` result as lists (scipy returns lists, not
+    arrays, when the run ends before the first sample)."""
+    times = list(np.asarray(result.t, dtype=float))
+    return times, list(np.reshape(result.y, (width, -1)).T)
 
 
 def _start(friction: ForwardMap, masses: np.ndarray, load: np.ndarray) -> np.ndarray:

@@ -282,6 +282,15 @@ class LimitSurface:
         """Whether the surface has facets: discrete point supports, where ``h`` has kinks."""
         return len(self._kernel.facets[0]) > 0
 
+    @property
+    def point_supports(self) -> tuple[np.ndarray, np.ndarray]:
+        """The discrete point supports: positions ``(P, 2)`` [m] in the surface's frame and the
+        friction force each can take ``(P,)`` [N] (``mu`` times its normal force); ``P = 0``
+        for patches. A part turning about one of them (its twist on that point's facet) keeps
+        it still while its friction holds."""
+        points, friction = self._kernel.facets
+        return np.array(points, dtype=float).reshape(-1, 2), self._scale * np.array(friction)
+
     def load(self, twist) -> np.ndarray:
         """Load ``(fx, fy, m)`` on the surface that sustains sliding with ``twist``.
 

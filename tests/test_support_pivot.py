@@ -1,0 +1,141 @@
+"""A body turning about one of its point supports while that point sticks: against the closed
+form of a bar turning about one end, the convex problem of a start solved by cvxpy, and an
+independent integration with the friction of every point regularised (``-c v / sqrt(|v|² +
+ε²)``, stiff, by Radau), whose answers approach the non-smooth ones in proportion to ``ε``."""
+
+import warnings
+
+import cvxpy as cp
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+from fixplan import LimitSurface, pressure
+from fixplan.motion import slide, start_acceleration
+
+MASS, INERTIA, NORMAL, MU = 0.5, 1e-3, 4.9, 0.3
+#: A bar on two equal point supports 0.1 m apart (at x = -0.05 and 0.05 from its centre).
+BAR = LimitSurface(pressure.points([[-0.05, 0.0], [0.05, 0.0]]), mu=MU, normal_force=NORMAL)
+#: A part on three point supports (centred at their centroid).
+TRIPOD = LimitSurface(
+    pressure.points([[-0.04, -0.02], [0.04, -0.02], [0.0, 0.03]]), mu=MU, normal_force=NORMAL
+)
+
+
+def regularised(surface, twist0, load, duration, eps=1e-9):
+    """Final world pose of the body sliding from rest pose 0 with the body-frame ``twist0``,
+    every point's friction ``-c v / sqrt(|v|² + eps²)`` (``eps`` [m/s])."""
+    points, friction = surface.point_supports
+
+    def rate(t, y):
+        c, s = np.cos(y[2]), np.sin(y[2])
+        vx, vy = c * y[3] + s * y[4], -s * y[3] + c * y[4]
+        velocities = np.stack([vx - y[5] * points[:, 1], vy + y[5] * points[:, 0]], axis=1)
+        forces = -(friction / np.sqrt((velocities**2).sum(axis=1) + eps**2))[:, None] * velocities
+        fx, fy = forces.sum(axis=0) + load[:2]
+        moment = (points[:, 0] * forces[:, 1] - points[:, 1] * forces[:, 0]).sum() + load[2]
+        return [y[3], y[4], y[5], (c * fx - s * fy) / MASS, (s * fx + c * fy) / MASS,
+                moment / INERTIA]  # fmt: skip
+
+    with warnings.catch_warnings():  # (overflows in Radau's finite-difference Jacobian)
+        warnings.simplefilter("ignore", RuntimeWarning)
+        solution = solve_ivp(rate, (0.0, duration), [0.0, 0.0, 0.0, *twist0], method="Radau",
+                             rtol=1e-11, atol=1e-14)  # fmt: skip
+    return solution.y[:3, -1]
+
+
+def still_point(moved, index, surface):
+    """World positions ``(n, 2)`` of point support ``index`` over the samples of ``moved``."""
+    px, py = surface.point_supports[0][index]
+    angles = moved.poses[:, 2]
+    return moved.poses[:, :2] + np.stack(
+        [np.cos(angles) * px - np.sin(angles) * py, np.sin(angles) * px + np.cos(angles) * py],
+        axis=1,
+    )
+
+
+def test_point_supports_are_the_points_and_their_share_of_the_friction():
+    points, friction = BAR.point_supports
+    np.testing.assert_array_equal(points, [[-0.05, 0.0], [0.05, 0.0]])
+    np.testing.assert_allclose(friction, [MU * NORMAL / 2] * 2, rtol=1e-15)
+    assert LimitSurface(pressure.disk(0.02), mu=MU).point_supports[0].shape == (0, 2)
+
+
+def test_a_bar_turning_about_one_end_stops_as_the_closed_form_says():
+    """Turning about the support at x = -0.05, the other one slides on a circle of radius 0.1
+    against its friction c: (I + m r²) ω' = -c d, so it stops at ω₀ I_p / (c d) after
+    turning ω₀ t / 2, the still end holding the centripetal and tangential forces. (The body
+    counts as stopped below 1e-9 of the run's speed scale: 2e-8 of the stop time here.)"""
+    rate = 2.0
+    moved = slide(BAR, mass=MASS, inertia=INERTIA, twist0=[0.0, 0.05 * rate, rate], duration=1.0)
+    friction, span = MU * NORMAL / 2, 0.1
+    about_end = INERTIA + MASS * 0.05**2
+    stop = rate * about_end / (friction * span)
+    assert moved.stopped == pytest.approx(stop, rel=1e-7)
+    assert moved.poses[-1, 2] == pytest.approx(rate * stop / 2, rel=1e-12)
+    ((start, end, index),) = moved.pivots
+    assert (start, index) == (0.0, 0) and end == moved.stopped
+    ends = still_point(moved, 0, BAR)
+    np.testing.assert_allclose(ends, np.tile([-0.05, 0.0], (len(ends), 1)), atol=1e-17)
+
+
+def test_a_spinning_tripod_slides_then_turns_about_a_support_as_regularised_friction_says():
+    """From a spin about its centroid it slides, turns about one support and stops (it ran
+    until the integrator gave up before): the final pose of the regularised integration within
+    1e-11 m and 1e-10 rad (at eps = 1e-9 m/s; it moves ~1e-11 per tenfold eps there)."""
+    moved = slide(TRIPOD, mass=MASS, inertia=INERTIA, twist0=[0.0, 0.0, 1.0], duration=0.05)
+    ((start, end, index),) = moved.pivots
+    assert 0.0 < start < end == moved.stopped < 0.05
+    reference = regularised(TRIPOD, [0.0, 0.0, 1.0], np.zeros(3), 0.05)
+    np.testing.assert_allclose(moved.poses[-1, :2], reference[:2], atol=1e-11)
+    assert moved.poses[-1, 2] == pytest.approx(reference[2], abs=1e-10)
+    turning = (moved.t >= start) & (moved.t <= end)
+    ends = still_point(moved, index, TRIPOD)[turning]
+    np.testing.assert_allclose(ends, np.tile(ends[0], (len(ends), 1)), atol=1e-17)
+
+
+@pytest.mark.parametrize("push", [0.8, 2.0])
+def test_a_body_at_rest_starts_to_turn_about_a_support_where_the_convex_problem_says(push):
+    """Pushed sideways at one support, the bar turns about the other: the minimiser of
+    ``½aᵀMa - L·a + h(a)`` (a second-order cone program in cvxpy) to 1e-7."""
+    load = np.array([0.0, push, 0.05 * push])
+    points, friction = BAR.point_supports
+    a = cp.Variable(3)
+    dissipation = sum(
+        c * cp.norm(cp.hstack([a[0] - a[2] * p[1], a[1] + a[2] * p[0]]))
+        for p, c in zip(points, friction, strict=True)
+    )
+    masses = np.array([MASS, MASS, INERTIA])
+    objective = 0.5 * cp.sum(cp.multiply(masses, cp.square(a))) - load @ a + dissipation
+    cp.Problem(cp.Minimize(objective)).solve(solver=cp.CLARABEL, tol_gap_abs=1e-12,
+                                              tol_gap_rel=1e-12, tol_feas=1e-12)  # fmt: skip
+    found = start_acceleration(BAR, load, mass=MASS, inertia=INERTIA)
+    np.testing.assert_allclose(found, a.value, rtol=1e-7, atol=1e-7 * np.abs(a.value).max())
+    assert found[0] == 0.0 and found[1] == pytest.approx(0.05 * found[2], rel=1e-15)
+
+
+def test_a_turn_ends_where_the_still_point_slips_and_the_body_slides_on_as_regularised():
+    """Pushed at one end by 2 N, the bar turns about the other end with ω' constant until the
+    centripetal force needed there exceeds its friction: the pivot ends at the root of |F(t)| =
+    c (closed form), then the bar slides; the final pose as the regularised integration's
+    within 3e-8 (SLIP_START: the slip starts at 10 times the stopping speed)."""
+    push = 2.0
+    load = np.array([0.0, push, 0.05 * push])
+    friction = MU * NORMAL / 2
+    about_end = INERTIA + MASS * 0.05**2
+    alpha = (0.1 * push - 0.1 * friction) / about_end  # moments about the still end
+
+    def excess(t):  # the still end's force F = m (α (p_y, -p_x) + ω² p) - f_a + f_o
+        rate = alpha * t
+        force = MASS * np.array([-0.05 * rate**2, 0.05 * alpha]) - [0.0, push] + [0.0, friction]
+        return float(np.hypot(*force)) - friction
+
+    slip = brentq(excess, 1e-6, 1.0, xtol=1e-15)
+    moved = slide(BAR, mass=MASS, inertia=INERTIA, twist0=[0.0, 0.0, 0.0], duration=0.2,
+                  load=lambda t, pose: load)  # fmt: skip
+    ((start, end, index),) = moved.pivots
+    assert (start, index) == (0.0, 0)
+    assert end == pytest.approx(slip, rel=1e-9)
+    reference = regularised(BAR, [0.0, 0.0, 0.0], load, 0.2)
+    np.testing.assert_allclose(moved.poses[-1], reference, atol=3e-8)
