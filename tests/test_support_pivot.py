@@ -139,3 +139,33 @@ def test_a_turn_ends_where_the_still_point_slips_and_the_body_slides_on_as_regul
     assert end == pytest.approx(slip, rel=1e-9)
     reference = regularised(BAR, [0.0, 0.0, 0.0], load, 0.2)
     np.testing.assert_allclose(moved.poses[-1], reference, atol=3e-8)
+
+
+def test_a_body_whose_point_support_comes_to_rest_as_it_stops_stops():
+    """A fuzzer's part on five points, whose slowest point came to rest with the body's rate at
+    2e-13 rad/s: a turn at that rate flipped its friction at every step (a ConvergenceError
+    after 100,000 evaluations); now it is a stop, and the body stays."""
+    points = [[-0.0261, -0.0207], [-0.1221, 0.09], [0.0572, -0.0163], [0.0387, 0.0141],
+              [-0.0277, 0.0489]]  # fmt: skip
+    surface = LimitSurface(pressure.points(points, [0.47, 0.979, 1.405, 0.961, 1.34]),
+                           mu=0.971, normal_force=13.978)  # fmt: skip
+    moved = slide(surface, mass=0.844, inertia=0.001133, twist0=[0.1683, 0.0376, 1.6529],
+                  duration=0.5)  # fmt: skip
+    assert moved.stops == (moved.stopped,) and 0.0 < moved.stopped < 0.5
+    np.testing.assert_array_equal(moved.twists[moved.t > moved.stopped], 0.0)
+
+
+def test_a_start_just_outside_the_surface_of_point_supports_meets_its_optimality_condition():
+    """A load 6e-8 outside the surface of five points (a fuzzer's): Powell's method stalled at
+    a residual of 3.8e-9 of the load; the start found satisfies ``M a - L + ∇h(a) = 0`` to
+    1e-9 of the load."""
+    points = [[-0.0066, 0.032], [0.0052, -0.0268], [0.0181, 0.0652], [0.0474, -0.0352],
+              [-0.0633, -0.0312]]  # fmt: skip
+    surface = LimitSurface(pressure.points(points, [0.205, 1.743, 0.26, 1.513, 0.516]),
+                           mu=0.877, normal_force=11.288)  # fmt: skip
+    direction = np.array([6.21412909, 0.64662295, -0.25569191])
+    load = direction * surface.safety_factor(direction) * (1 + 6e-8)
+    masses = np.array([0.669, 0.669, 0.001608])
+    found = start_acceleration(surface, load, mass=0.669, inertia=0.001608)
+    residual = (masses * found - load + surface.load(found)) / np.sqrt(masses)
+    assert np.linalg.norm(residual) <= 1e-9 * np.linalg.norm(load / np.sqrt(masses))
