@@ -288,9 +288,9 @@ def _integrate(rate, span, state, samples, events, atol):
     raise ConvergenceError(
         f"slide: the motion from t = {span[0]:.6g} s took more than {MAX_EVALUATIONS:,} "
         "evaluations of its equations, or failed, with RK45 and with LSODA: its friction "
-        "switches faster than either can follow (as at a point contact of a ContactSetSurface, whose turns "
-        "about its points are not followed; a LimitSurface's point supports are). Support the "
-        "part on a patch, or shorten the duration"
+        "switches faster than either can follow (as at a point contact of a "
+        "ContactSetSurface, whose turns about its points are not followed; a LimitSurface's "
+        "point supports are). Support the part on a patch, or shorten the duration"
     )
 
 
@@ -384,11 +384,9 @@ class _Body:
         return None if found is None else self._turning(pose, *found)
 
     def turn_at(self, t: float, state: np.ndarray, index: int) -> _Turning | None:
-        """The turn about point support ``index``, now at rest in the sliding ``state``, where
-        its friction keeps it still (``None``: it slips on)."""
+        """The turn about point support ``index``, now at rest in the sliding ``state`` (whose
+        rate is not 0), where its friction keeps it still (``None``: it slips on)."""
         rate = float(state[5])
-        if rate == 0.0:
-            return None
         turn = Turn(self.supports.points[index], self.supports.capacity(index), self.masses)
         sense = float(np.sign(rate))
         applied = self.applied(t, state[:3])
