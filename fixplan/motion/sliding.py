@@ -313,12 +313,11 @@ class _Turning:
 
     def pose(self, angle: float) -> np.ndarray:
         """The world pose of the centre of mass at the body's ``angle`` [rad]."""
-        x, y = self.anchor - _rotated(angle, np.array([*self.turn.point, 0.0]))[:2]
-        return np.array([x, y, angle])
+        return np.array([*(self.anchor - _offset(self.turn.point, angle)), angle])
 
     def state(self, angle: float, rate: float) -> np.ndarray:
         """The slide's state ``(pose, world velocity, rate)`` at ``angle`` and ``rate``."""
-        reach = _rotated(angle, np.array([*self.turn.point, 0.0]))
+        reach = _offset(self.turn.point, angle)
         return np.array([*self.pose(angle), rate * reach[1], -rate * reach[0], rate])
 
 
@@ -396,8 +395,7 @@ class _Body:
 
     @staticmethod
     def _turning(pose: np.ndarray, index: int, turn: Turn, sense: float) -> _Turning:
-        anchor = pose[:2] + _rotated(pose[2], np.array([*turn.point, 0.0]))[:2]
-        return _Turning(index, turn, sense, anchor)
+        return _Turning(index, turn, sense, pose[:2] + _offset(turn.point, pose[2]))
 
 
 @dataclass(frozen=True, slots=True)
@@ -424,9 +422,8 @@ class _Run:
         stopping = _terminal(lambda t, y: body.speed(y) - stop_speed, -1.0)
         times, states, slipping = [], [], np.zeros(0, dtype=int)
         if body.supports is not None and np.any(state[3:]):  # (a point already still)
-            speeds = body.supports.speeds(_rotated(-state[2], state[3:]))
-            index = int(np.argmin(speeds))
-            ended = self._still(span[0], state, index) if speeds[index] <= stop_speed else None
+            index, speed = self._slowest_point(state, slipping)
+            ended = self._still(span[0], state, index) if speed <= stop_speed else None
             if ended is not None:
                 return times, states, ended
         while True:
@@ -437,17 +434,14 @@ class _Run:
             more_times, more_states = _samples(result, len(state))
             times += more_times
             states += more_states
-            hits = [(float(t[0]), k) for k, t in enumerate(result.t_events) if t.size]
-            if not hits:
+            event = _first_event(result)
+            if event is None:
                 return times, states, None
-            t, which = min(hits)
-            state = result.y_events[which][0].copy()
+            t, which, state = event
             if which == 0:
                 state[3:] = 0.0
                 return times, states, (t, state, None)
-            speeds = body.supports.speeds(_rotated(-state[2], state[3:]))
-            speeds[slipping] = np.inf
-            index = int(np.argmin(speeds))
+            index = self._slowest_point(state, slipping)[0]
             ended = self._still(t, state, index)
             if ended is not None:
                 return times, states, ended
@@ -466,16 +460,17 @@ class _Run:
         turning = self.body.turn_at(t, state, index)
         return None if turning is None else (t, turning.state(state[2], state[5]), turning)
 
+    def _slowest_point(self, state: np.ndarray, slipping: np.ndarray) -> tuple[int, float]:
+        """The slowest point support in the sliding ``state`` but for those ``slipping``: its
+        index and speed [m/s]."""
+        speeds = self.body.supports.speeds(_rotated(-state[2], state[3:]))
+        speeds[slipping] = np.inf
+        index = int(np.argmin(speeds))
+        return index, float(speeds[index])
+
     def _point_at_rest(self, slipping: np.ndarray):
         """The event of a point support (not among ``slipping``) coming to rest."""
-        speeds, stop_speed = self.body.supports.speeds, self.stop_speed
-
-        def event(t, y):
-            moving = speeds(_rotated(-y[2], y[3:]))
-            moving[slipping] = np.inf
-            return float(np.min(moving)) - stop_speed
-
-        return event
+        return lambda t, y: self._slowest_point(y, slipping)[1] - self.stop_speed
 
     def turning(self, turning: _Turning, span, state, grid) -> tuple[list, list, tuple | None]:
         """:meth:`sliding` for a body turning about a point support: its angle and rate
@@ -500,11 +495,10 @@ class _Run:
         result = _integrate(rate, span, start, grid[grid > span[0]], events, atol)
         angles, samples = _samples(result, 2)
         states = [turning.state(*y) for y in samples]
-        hits = [(float(t[0]), k) for k, t in enumerate(result.t_events) if t.size]
-        if not hits:
+        event = _first_event(result)
+        if event is None:
             return angles, states, None
-        t, which = min(hits)
-        angle, rate_now = result.y_events[which][0]
+        t, which, (angle, rate_now) = event
         if which == 0:
             return angles, states, (t, turning.state(angle, 0.0), None)
         # The point slips where its friction gives out, along the force it gave, reversed (the
@@ -514,6 +508,16 @@ class _Run:
         slip = -SLIP_START * self.stop_speed * force / np.hypot(*force)
         end[3:5] += _rotated(angle, np.array([*slip, 0.0]))[:2]
         return angles, states, (t, end, None)
+
+
+def _first_event(result) -> tuple[float, int, np.ndarray] | None:
+    """The first terminal event of a ``solve_ivp`` result: its time, index and state (a copy);
+    ``None`` where the run reached its end."""
+    hits = [(float(t[0]), k) for k, t in enumerate(result.t_events) if t.size]
+    if not hits:
+        return None
+    t, which = min(hits)
+    return t, which, result.y_events[which][0].copy()
 
 
 def _samples(result, width: int) -> tuple[list, list]:
@@ -551,6 +555,11 @@ def _start(friction: ForwardMap, masses: np.ndarray, load: np.ndarray) -> np.nda
         f"the starting motion under the load {load} was not found ({solution.message}; "
         f"gradient residual {residual:.3g})"
     )
+
+
+def _offset(point: np.ndarray, angle: float) -> np.ndarray:
+    """A body-frame ``point`` ``(2,)`` [m] from the centre of mass, in the world at ``angle``."""
+    return _rotated(angle, np.array([*point, 0.0]))[:2]
 
 
 def _rotated(angle: float, twist: np.ndarray) -> np.ndarray:
