@@ -336,6 +336,62 @@ def _emit_per_call(new: dict, old: dict | None, ref: str) -> None:
         )
 
 
+def function_fields() -> dict:
+    """Surfaces of users' pressure functions (integrated by adapted rules, not closed forms)."""
+    return {
+        "disk, p = 1 + 40 x": pressure.from_function(pressure.disk(0.01), lambda x, y: 1 + 40 * x),
+        "rectangle 4:1, p = exp(-(x/a)²)": pressure.from_function(
+            pressure.rectangle(0.04, 0.01), lambda x, y: np.exp(-((x / 0.01) ** 2))
+        ),
+    }
+
+
+def per_call_times(surface, loads) -> tuple[np.ndarray, np.ndarray]:
+    """Times [s] and safety factors of single ``motion_and_safety_factor`` calls."""
+    surface.motion_and_safety_factor(loads[0])  # warm up
+    times, safety = np.empty(len(loads)), np.empty(len(loads))
+    for i, load in enumerate(loads):
+        start = time.perf_counter()
+        safety[i] = surface.motion_and_safety_factor(load)[1]
+        times[i] = time.perf_counter() - start
+    return times, safety
+
+
+def bench_function_fields(count: int) -> None:
+    """The inverse map per call on function fields, Newton steered by the analytic Hessians
+    against central differences of the gradient (the Hessians it had before, six more
+    evaluations per step; restored in this run by calling the base class's methods)."""
+    from fixplan.surface.function_kernel import FunctionKernel
+    from fixplan.surface.kernels import SupportKernel
+
+    print(f"inverse map per call on function fields, {count} loads from twists (x 0.5-1.5)")
+    for name, field in function_fields().items():
+        surface = LimitSurface(field, mu=0.5, normal_force=10.0)
+        rng = np.random.default_rng(2)
+        twists = rng.normal(size=(count, 3)) * [1.0, 1.0, 1.0 / surface.characteristic_length]
+        loads = surface.load(twists) * rng.uniform(0.5, 1.5, (count, 1))
+        analytic, safety = per_call_times(surface, loads)
+        with contextlib.ExitStack() as stack:
+            for method in ("newton_terms", "hessian"):
+                stack.callback(setattr, FunctionKernel, method, getattr(FunctionKernel, method))
+                setattr(FunctionKernel, method, getattr(SupportKernel, method))
+            differences, reference = per_call_times(surface, loads)
+        gap = float(np.max(np.abs(safety - reference) / reference))
+        ratio = np.median(differences) / np.median(analytic)
+        print(f"  {name:32s} analytic Hessians {figures_us(analytic)}; central differences "
+              f"{figures_us(differences)}; x{ratio:.1f}; safety factors agree to {gap:.1e}")  # fmt: skip
+        emit(
+            f"inverse map per call, function field: {name} ({count} loads)",
+            figures_us(analytic),
+            f"Hessians by central differences: {figures_us(differences)}",
+            f"{ratio:.1f}× (safety factors within {gap:.0e})",
+        )
+
+
+def figures_us(times: np.ndarray) -> str:
+    return f"median {np.median(times) * 1e6:,.0f} µs, p99 {np.percentile(times, 99) * 1e6:,.0f} µs"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="smaller sizes (for CI)")
@@ -351,10 +407,12 @@ def main() -> None:
         bench_forward(2000, 2000, 3)
         bench_inverse(4096, 500, 3, 3)
         bench_per_call(200, 3, args.baseline)
+        bench_function_fields(50)
     else:
         bench_forward(10_000, 10_000, 5)
         bench_inverse(4096, 4000, 20, 5)
         bench_per_call(1000, 5, args.baseline)
+        bench_function_fields(300)
     bench_accuracy()
 
 

@@ -551,21 +551,40 @@ class FunctionKernel(SupportKernel):
         return self._layout.size
 
     def evaluate(self, twists):
+        return self._terms(twists, with_hessian=False)[:2]
+
+    def newton_terms(self, twists):
+        return self._terms(twists, with_hessian=True)
+
+    def hessian(self, twists):
+        return self._terms(twists, with_hessian=True)[2]
+
+    def _terms(self, twists, with_hessian: bool):
+        """Support values ``(K,)``, loads ``(K, 3)`` and, ``with_hessian``, Hessians
+        ``(K, 3, 3)`` (else ``None``) by the same rules: the Hessian of ``|v|`` is
+        ``Aᵀ (I - v̂ v̂ᵀ) A / |v|`` (``A = [[1, 0, -y], [0, 1, x]]``, ``v = A V``)."""
         twists = np.ascontiguousarray(twists, dtype=float)
         near = self._near(twists)
         h = np.zeros(len(twists))
         loads = np.zeros((len(twists), 3))
+        hess = np.zeros((len(twists), 3, 3)) if with_hessian else None
         mixed = ~np.all(near, axis=1)  # twists for which the compiled fixed rule is summed
         if np.any(mixed):
-            h[mixed], loads[mixed] = self._far.evaluate(twists[mixed])
+            if with_hessian:
+                h[mixed], loads[mixed], hess[mixed] = self._far.newton_terms(twists[mixed])
+            else:
+                h[mixed], loads[mixed] = self._far.evaluate(twists[mixed])
         pair_twist, pair_region = np.nonzero(near)
         for chunk in self._chunks(pair_region):
-            dh, dloads = self._near_correction(
-                twists, pair_twist[chunk], pair_region[chunk], mixed[pair_twist[chunk]]
-            )
+            dh, dloads, dhess = self._near_correction(
+                twists, pair_twist[chunk], pair_region[chunk], mixed[pair_twist[chunk]],
+                with_hessian,
+            )  # fmt: skip
             h += dh
             loads += dloads
-        return h, loads
+            if with_hessian:
+                hess += dhess
+        return h, loads, hess
 
     def rule_disagreement(self) -> float:
         """Largest difference of ``h`` between the polar rule about a centre of rotation near a
@@ -584,9 +603,9 @@ class FunctionKernel(SupportKernel):
         twists = np.column_stack([centers[:, 1], -centers[:, 0], np.ones(len(centers))])
         pair_region = np.repeat(regions, len(centers) // len(regions))
         pair_twist = np.arange(len(centers))
-        difference, _ = self._near_correction(
-            twists, pair_twist, pair_region, np.ones(len(centers), dtype=bool)
-        )
+        difference = self._near_correction(
+            twists, pair_twist, pair_region, np.ones(len(centers), dtype=bool), False
+        )[0]
         power = float(np.max(self._far.evaluate(twists)[0]))  # (0: no friction anywhere)
         return float(np.max(np.abs(difference))) / power if power > 0.0 else 0.0
 
@@ -654,9 +673,15 @@ class FunctionKernel(SupportKernel):
             parts.append((pairs[rows], *rest))
         return [np.concatenate(arrays) for arrays in zip(*parts, strict=True)]
 
-    def _near_correction(self, twists, pair_twist, pair_region, summed):
-        """Change of ``h`` ``(K,)`` and loads ``(K, 3)``: polar rules replace the fixed rule
-        on the near pairs (whose fixed rule was ``summed`` or not)."""
+    def _near_correction(self, twists, pair_twist, pair_region, summed, with_hessian):
+        """Change of ``h`` ``(K,)``, loads ``(K, 3)`` and, ``with_hessian``, Hessians
+        ``(K, 3, 3)`` (else ``None``): polar rules replace the fixed rule on the near pairs
+        (whose fixed rule was ``summed`` or not).
+
+        On a ray ``x = c + ρ ê`` from the centre of rotation ``v̂ = ±J ê``, so ``I - v̂ v̂ᵀ = ê êᵀ``,
+        and ``Aᵀ ê = (ê, x × ê)`` is the same all along it: a node of weight ``dA`` adds
+        ``dA / (|w| ρ) (Aᵀ ê)(Aᵀ ê)ᵀ`` to the Hessian (``dA`` holds a factor ``ρ``, or the
+        rules' sinh maps absorb ``1/ρ``, as they do ``ρ`` for ``h``)."""
         lay = self._layout
         vx, vy, w = twists[pair_twist].T
         centers = np.column_stack([-vy / w, vx / w])
@@ -676,16 +701,29 @@ class FunctionKernel(SupportKernel):
         arm = np.einsum("ij,ij->i", points, unit)
         moment = sign * np.bincount(pair, values * arm, count)
         loads = np.column_stack([force_x, force_y, moment])
+        hess = None
+        if with_hessian:
+            along = np.column_stack([unit, points[:, 0] * unit[:, 1] - points[:, 1] * unit[:, 0]])
+            hess = _outer_sums(pair, values / (spin[pair] * rho), along, count)
         if np.any(summed):
-            far_h, far_loads = self._fixed_part(twists, pair_twist[summed], pair_region[summed])
+            far_h, far_loads, far_hess = self._fixed_part(
+                twists, pair_twist[summed], pair_region[summed], with_hessian
+            )
             h[summed] -= far_h
             loads[summed] -= far_loads
+            if with_hessian:
+                hess[summed] -= far_hess
         size = len(twists)
         delta = np.column_stack([np.bincount(pair_twist, part, size) for part in loads.T])
-        return np.bincount(pair_twist, h, size), delta
+        if with_hessian:
+            flat = hess.reshape(count, 9)
+            hess = np.column_stack([np.bincount(pair_twist, part, size) for part in flat.T])
+            hess = hess.reshape(size, 3, 3)
+        return np.bincount(pair_twist, h, size), delta, hess
 
-    def _fixed_part(self, twists, pair_twist, pair_region):
-        """The fixed rule's ``h`` and loads of each pair (what the compiled sum included)."""
+    def _fixed_part(self, twists, pair_twist, pair_region, with_hessian):
+        """The fixed rule's ``h``, loads and (``with_hessian``, else ``None``) Hessians of each
+        pair (what the compiled sum included)."""
         lay = self._layout
         first = lay.far_offsets[pair_region]
         counts = lay.far_offsets[pair_region + 1] - first
@@ -696,7 +734,8 @@ class FunctionKernel(SupportKernel):
         vx, vy, w = twists[pair_twist[pair]].T
         ux, uy = vx - w * y, vy + w * x
         speed = np.hypot(ux, uy)
-        scale = np.where(speed > 0.0, weight / np.where(speed > 0.0, speed, 1.0), 0.0)
+        moving = speed > 0.0
+        scale = np.where(moving, weight / np.where(moving, speed, 1.0), 0.0)
         count = len(pair_region)
         h = np.bincount(pair, weight * speed, count)
         loads = np.column_stack(
@@ -706,4 +745,20 @@ class FunctionKernel(SupportKernel):
                 np.bincount(pair, scale * (x * uy - y * ux), count),
             ]
         )
-        return h, loads
+        hess = None
+        if with_hessian:  # I - ûûᵀ = n nᵀ with n = J û: Aᵀ n = (-uy, ux, x ux + y uy) / |u|
+            across = np.column_stack([-uy, ux, x * ux + y * uy])
+            squared = np.where(moving, speed, 1.0) ** 2
+            hess = _outer_sums(pair, scale / squared, across, count)
+        return h, loads, hess
+
+
+def _outer_sums(groups: np.ndarray, weights: np.ndarray, vectors: np.ndarray, count: int):
+    """``(count, 3, 3)``: the sums of ``weights[i] * vectors[i] vectors[i]ᵀ`` by ``groups``."""
+    out = np.empty((count, 3, 3))
+    for i in range(3):
+        for j in range(i, 3):
+            out[:, i, j] = out[:, j, i] = np.bincount(
+                groups, weights * vectors[:, i] * vectors[:, j], count
+            )
+    return out
