@@ -223,6 +223,21 @@ def load_distributions(surface, count: int, rng) -> dict:
     return loads
 
 
+def per_call_times(surface, loads) -> tuple[np.ndarray, np.ndarray]:
+    """Times [s] and safety factors (NaN where the version raised ConvergenceError) of single
+    ``motion_and_safety_factor`` calls, after one to compile and warm up."""
+    from fixplan import ConvergenceError
+
+    surface.motion_and_safety_factor(loads[0])
+    times, safety = np.empty(len(loads)), np.full(len(loads), np.nan)
+    for i, load in enumerate(loads):
+        start = time.perf_counter()
+        with contextlib.suppress(ConvergenceError):
+            safety[i] = surface.motion_and_safety_factor(load)[1]
+        times[i] = time.perf_counter() - start
+    return times, safety
+
+
 def measure_per_call(count: int, batch_repeats: int) -> dict:
     """Single-call median and p99 [s], batched throughput [queries/s], the safety factors (NaN
     where the version raised ConvergenceError) and the number of such failures, per surface and
@@ -235,14 +250,7 @@ def measure_per_call(count: int, batch_repeats: int) -> dict:
     for name, surface in per_call_surfaces().items():
         rng = np.random.default_rng(2)
         for distribution, loads in load_distributions(surface, count, rng).items():
-            surface.motion_and_safety_factor(loads[0])  # compile, warm up
-            times = np.empty(count)
-            safety = np.full(count, np.nan)
-            for i, load in enumerate(loads):
-                start = time.perf_counter()
-                with contextlib.suppress(ConvergenceError):
-                    safety[i] = surface.motion_and_safety_factor(load)[1]
-                times[i] = time.perf_counter() - start
+            times, safety = per_call_times(surface, loads)
             key = f"{name} | {distribution}"
             solved = loads[~np.isnan(safety)]
             batches.append((key, surface, solved))
@@ -344,17 +352,6 @@ def function_fields() -> dict:
             pressure.rectangle(0.04, 0.01), lambda x, y: np.exp(-((x / 0.01) ** 2))
         ),
     }
-
-
-def per_call_times(surface, loads) -> tuple[np.ndarray, np.ndarray]:
-    """Times [s] and safety factors of single ``motion_and_safety_factor`` calls."""
-    surface.motion_and_safety_factor(loads[0])  # warm up
-    times, safety = np.empty(len(loads)), np.empty(len(loads))
-    for i, load in enumerate(loads):
-        start = time.perf_counter()
-        safety[i] = surface.motion_and_safety_factor(load)[1]
-        times[i] = time.perf_counter() - start
-    return times, safety
 
 
 def bench_function_fields(count: int) -> None:

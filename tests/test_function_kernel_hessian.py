@@ -106,7 +106,8 @@ def test_smooth_fields_obey_the_hessian_laws_and_match_differences_of_the_gradie
 
 def test_a_query_whose_rules_are_noisier_than_their_hessian_ends_at_the_noise():
     """With p = exp(-(x/a)²) on a rectangle 4a long and a centre of rotation outside it, the
-    rules' gradient is accurate to about 1e-7 and its derivative to 1e-2 of the exact Hessian:
+    rules' gradient is within 3e-7 of the fixed rule's, and its derivative 1.2 % off the exact
+    Hessian in one entry:
     Newton on the exact Hessian stalled with a decrement of 4e-12 of h and took steps of 1e-12
     for 100 iterations (about 4,000 evaluations). It now stops there, and its answer is the one
     that Newton on differences of the rules' gradient finds, to that noise."""
@@ -114,7 +115,7 @@ def test_a_query_whose_rules_are_noisier_than_their_hessian_ends_at_the_noise():
         pressure.rectangle(0.04, 0.01), lambda x, y: np.exp(-((x / 0.01) ** 2))
     )
     surface = LimitSurface(field, mu=0.5, normal_force=10.0)
-    kernel = surface._kernel
+    assert isinstance(surface._kernel, FunctionKernel)
     load = surface.load(np.array([0.03644802, 1.90801459, -31.94578014])) * 1.2
     counted = {"evaluations": 0}
     evaluate = FunctionKernel.evaluate
@@ -132,7 +133,6 @@ def test_a_query_whose_rules_are_noisier_than_their_hessian_ends_at_the_noise():
         patch.setattr(FunctionKernel, "newton_terms", counting(terms))
         motion, safety = surface.motion_and_safety_factor(load)
     assert counted["evaluations"] < 40
-    assert isinstance(kernel, FunctionKernel)
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(FunctionKernel, "newton_terms", SupportKernel.newton_terms)
         patch.setattr(FunctionKernel, "hessian", SupportKernel.hessian)

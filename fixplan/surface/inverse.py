@@ -47,7 +47,7 @@ from fixplan.tolerances import (
 #: are accurate to 1e-12..1e-6, and their exact Hessian is not that of their rules: with
 #: ``p = exp(-(x/a)²)`` on a rectangle four lengths ``a`` long, a centre of rotation outside it
 #: left the decrement at 4e-12 of ``h`` while the line search took steps of 1e-12, for all 100
-#: iterations (0.7 s per query instead of 2 ms).
+#: iterations (0.7 s for a query that now takes 10 ms).
 NOISE_DECREMENT = 1e-8
 
 
