@@ -169,3 +169,73 @@ def test_a_start_just_outside_the_surface_of_point_supports_meets_its_optimality
     found = start_acceleration(surface, load, mass=0.669, inertia=0.001608)
     residual = (masses * found - load + surface.load(found)) / np.sqrt(masses)
     assert np.linalg.norm(residual) <= 1e-9 * np.linalg.norm(load / np.sqrt(masses))
+
+
+def test_a_load_ramped_through_a_facet_starts_a_turn_at_the_instant_it_leaves():
+    """The bar pushed sideways at one end by ``5 t`` N: the load leaves the surface through the
+    facet of the turn about the other end when the push equals that end's friction ``c``, at
+    ``t0 = c / 5``; the bar then turns with ``α = 0.1 (5 t - c) / I_end`` (moments about the
+    still end), so ``θ = 0.5 (t - t0)³ / (6 I_end)``, and the still end does not slip in 0.3 s.
+    At ``t0`` the load lies on the surface, where the turn's acceleration is 0 to rounding:
+    decided there, the start was no turn, and the smooth start failed at the still end's kink
+    (a ConvergenceError)."""
+    friction = MU * NORMAL / 2
+    about_end = INERTIA + MASS * 0.05**2
+    start = friction / 5.0
+    moved = slide(BAR, mass=MASS, inertia=INERTIA, twist0=[0.0, 0.0, 0.0], duration=0.3,
+                  load=lambda t, pose: np.array([0.0, 5.0 * t, 0.25 * t]))  # fmt: skip
+    assert moved.starts == pytest.approx((start,), rel=1e-15)
+    ((begin, end, index),) = moved.pivots
+    assert (begin, end, index) == (moved.starts[0], 0.3, 0)
+    turning = np.clip(moved.t - start, 0.0, None)
+    angle = 0.5 * turning**3 / (6 * about_end)
+    np.testing.assert_allclose(moved.poses[:, 2], angle, rtol=0, atol=1e-14 * angle.max())
+    rate = 0.5 * turning**2 / (2 * about_end)
+    np.testing.assert_allclose(moved.twists[:, 2], rate, rtol=0, atol=1e-14 * rate.max())
+    ends = still_point(moved, 0, BAR)
+    np.testing.assert_allclose(ends, np.tile(ends[0], (len(ends), 1)), atol=1e-17)
+
+
+#: Fuzzed parts on four and five points with a disk patch, masses ``(m, m, I)`` and loads about
+#: 1e-9 outside their surfaces, where the root finders in the acceleration stalled.
+BARELY_OUTSIDE = [
+    (
+        [[-0.148805558575489, -0.015251194029628387], [0.07249439611993984, -0.06219807359282814],
+         [0.00266052988578339, 0.07499308101051352], [-0.058410237696540225, 0.04053108156280281],
+         [0.09494489539055573, 0.022348211712440183]],
+        [1.283450407003479, 0.27611424299593224, 0.8119963093548805, 0.3470597555036824,
+         1.9482300289636443],
+        (0.6299016792748217, 10.6458647620788, 0.029518738272406607, 2.1664907216205513),
+        (0.9200795873696686, 0.002625951971485497),
+        [6.332381068496494, 1.779782875185692, 0.3112434929012648],
+    ),
+    (
+        [[-0.018139454975427637, -0.11836399035990273], [0.05217819174567628, -0.060509314294145355],
+         [-0.008488909188619699, 0.03188862866524147], [0.007222382083640937, -0.04298824672694563]],
+        [0.588756340429972, 0.8902243499962925, 0.9484649860147152, 0.753502166526899],
+        (0.4189171153212212, 15.128910857000424, 0.013257589694512167, 2.961881214327359),
+        (0.3329276829096791, 0.0008038957670758671),
+        [-2.541637258894765, 3.2820265765952614, 0.296498206001015],
+    ),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("points", "weights", "support", "body", "load"), BARELY_OUTSIDE)
+def test_a_start_barely_outside_a_surface_of_points_and_a_patch_meets_its_optimality_condition(
+    points, weights, support, body, load
+):
+    """Loads 1.1e-9 and 1.7e-9 outside (fuzzed slides): the acceleration, 1e-9 of the load's
+    size, was not found to 1e-9 of the load (Powell's method and Levenberg–Marquardt stalled);
+    solved for its direction alone, it meets ``M a - L + ∇h(a) = 0`` to 1e-14 of the load."""
+    mu, normal_force, radius, disk_force = support
+    surface = LimitSurface.combine([
+        LimitSurface(pressure.points(points, weights), mu=mu, normal_force=normal_force),
+        LimitSurface(pressure.disk(radius), mu=0.3, normal_force=disk_force),
+    ])  # fmt: skip
+    load = np.array(load)
+    assert 1e-9 < 1.0 - surface.safety_factor(load) < 2e-9
+    mass, inertia = body
+    masses = np.array([mass, mass, inertia])
+    found = start_acceleration(surface, load, mass=mass, inertia=inertia)
+    residual = (masses * found - load + surface.load(found)) / np.sqrt(masses)
+    assert np.linalg.norm(residual) <= 1e-14 * np.linalg.norm(load / np.sqrt(masses))
