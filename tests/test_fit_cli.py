@@ -20,6 +20,7 @@ from fixplan import LimitSurface, pressure
 from fixplan.io.cli import EXIT_INVALID_INPUT, EXIT_OK, main
 from fixplan.io.fit_data import MAX_ISSUES, read_fit_data
 from fixplan.io.fit_figures import fit_errors_figure, fit_sections_figure, fit_split, pair_errors
+from fixplan.io.report_document import MANIFEST
 from fixplan.io.toml_schema import ProblemFileError
 from fixplan.motion import Fit, fit, synthetic
 from fixplan.motion.fitted_quartic import MONOMIALS
@@ -193,7 +194,7 @@ def reports(tmp_path_factory):
 
 def test_the_report_folder_holds_every_file(reports):
     first, _ = reports
-    assert {p.name for p in first.iterdir()} == REPORT_FILES
+    assert {p.name for p in first.iterdir()} == REPORT_FILES | {MANIFEST}
     markdown = (first / "report.md").read_text(encoding="utf-8")
     for words in ("# fixplan fit report: data.csv", "## Fitted surface", "## Errors",
                   "](sections.png)", "](errors.png)", "`x^4`", "synthetic pairs of a 0.1 m"):  # fmt: skip

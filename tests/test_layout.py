@@ -19,6 +19,7 @@ from fixplan.design.candidates import sample_surface
 from fixplan.design.layout import LayoutSearch
 from fixplan.io.cli import main
 from fixplan.io.problem_file import load_problem
+from fixplan.io.report_document import MANIFEST
 from fixplan.surface.pressure import disk
 
 #: Largest relative difference between a masked re-solve and the separately built problem.
@@ -233,7 +234,7 @@ def test_layout_command_prints_the_best_layouts_and_writes_the_report(tmp_path, 
     best = output.splitlines()[3].split()
     assert best[0] == "1" and float(best[1]) > 0
     files = sorted(p.name for p in (tmp_path / "out").iterdir())
-    assert files == ["layout-1.png", "layout-2.png", "report.html", "report.md"]
+    assert files == [MANIFEST, "layout-1.png", "layout-2.png", "report.html", "report.md"]
     assert "Best layouts" in (tmp_path / "out" / "report.md").read_text()
 
 

@@ -21,6 +21,7 @@ import pytest
 from fixplan.io.cli import EXIT_INVALID_INPUT, EXIT_OK, main
 from fixplan.io.figures import trajectory_figure
 from fixplan.io.push_file import load_push
+from fixplan.io.report_document import MANIFEST
 from fixplan.io.toml_schema import ProblemFileError
 from fixplan.models import Ellipsoid
 from fixplan.motion import LinePusher, PointPusher, push
@@ -102,7 +103,7 @@ def test_a_push_report_is_complete_and_reproducible(tmp_path):
         assert main(["push", str(path), "--report", str(folder), "--quiet"]) == EXIT_OK
     names = {p.name for p in folders[0].iterdir()}
     assert names == {"push.json", "report.md", "report.html", "trajectory.csv", "trajectory.png",
-                     "trajectory.gif"}  # fmt: skip
+                     "trajectory.gif", MANIFEST}  # fmt: skip
     for name in sorted(names):
         assert (folders[0] / name).read_bytes() == (folders[1] / name).read_bytes(), name
     rows = (folders[0] / "trajectory.csv").read_text().splitlines()

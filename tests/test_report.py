@@ -26,6 +26,7 @@ from fixplan.errors import InvalidArgumentError
 from fixplan.io.figures import contact_section_figure, layout_figure, safety_figure
 from fixplan.io.problem_file import load_problem
 from fixplan.io.report import _solver_text, default_sliding_subspace, write_report
+from fixplan.io.report_document import MANIFEST
 from fixplan.planner.contact_models import contact_model
 from fixplan.planner.plan import Plan
 from fixplan.planner.planner import Planner
@@ -186,7 +187,7 @@ def test_the_report_writes_every_expected_file_and_lists_what_it_wrote(reports):
     folder, written = reports[1]
     expected = STATIC_FILES | CONTACT_FIGURES | {"contact-set.png"}
     assert {p.name for p in written} == expected
-    assert {p.name for p in folder.iterdir()} == expected
+    assert {p.name for p in folder.iterdir()} == expected | {MANIFEST}
     assert all(p.parent == folder for p in written)
 
 

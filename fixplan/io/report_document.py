@@ -20,6 +20,10 @@ from pathlib import Path
 from fixplan.errors import FixplanError
 from fixplan.io import figures
 
+#: The file of a report folder that names the files of the report last written there: the next
+#: report into the folder removes those it does not write again (files of others stay).
+MANIFEST = ".fixplan-report"
+
 _MARKDOWN_SPECIAL = re.compile(r"([\\`*_<>|])")
 _MARKDOWN_LINK = re.compile(r"([\[\]])")
 _CSS = """\
@@ -201,7 +205,9 @@ class Writer:
 @contextlib.contextmanager
 def staged_folder(directory: Path) -> Iterator[Path]:
     """A temporary folder for the files of the report folder ``directory``; on success its
-    files are moved there (the folder is created), on failure it is removed."""
+    files are moved there (the folder is created) and the files of the report written there
+    before that this one does not write again are removed (:data:`MANIFEST`), on failure it is
+    removed."""
     if directory.is_file():
         raise ReportError(f"cannot write the report folder {directory}: a file has its name")
     try:
@@ -212,9 +218,14 @@ def staged_folder(directory: Path) -> Iterator[Path]:
         raise ReportError(f"cannot create the report folder {directory}: {exc}") from exc
     try:
         yield staging
+        names = sorted(path.name for path in staging.iterdir())
+        (staging / MANIFEST).write_text("".join(f"{name}\n" for name in names), "utf-8")
         if directory.is_dir():
+            stale = _reported(directory) - set(names)
             for path in staging.iterdir():
                 os.replace(path, directory / path.name)
+            for name in stale:
+                (directory / name).unlink(missing_ok=True)
         else:
             directory.parent.mkdir(parents=True, exist_ok=True)
             os.replace(staging, directory)
@@ -222,3 +233,17 @@ def staged_folder(directory: Path) -> Iterator[Path]:
         raise ReportError(f"cannot write the report folder {directory}: {exc}") from exc
     finally:
         shutil.rmtree(staging, ignore_errors=True)
+
+
+def _reported(directory: Path) -> set[str]:
+    """The files of the report last written into ``directory`` (:data:`MANIFEST`) that are
+    still there: plain names of files in it (a name with a path in it is not one)."""
+    try:
+        listed = (directory / MANIFEST).read_text("utf-8").splitlines()
+    except (OSError, UnicodeDecodeError):
+        return set()
+    return {
+        name for name in listed
+        if name not in ("", ".", "..", MANIFEST) and Path(name).name == name
+        and "\\" not in name and (directory / name).is_file()
+    }  # fmt: skip
