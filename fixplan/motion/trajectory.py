@@ -16,7 +16,9 @@ the contact (bisection on the time within the step), and continues with both poi
 the part rotates onto the face without passing through it, then rides flush or rotates off as
 the mechanics say. After each integrated stretch in which the face presses, the part is put back
 onto the face along its normal: the integration moves the contact off it by the step's local
-error (third order), which would otherwise add up to a gap or an overlap.
+error (third order), which would otherwise add up to a gap or an overlap. A round pusher's step
+that ends with the pusher inside the part likewise moves the part out along the outline's normal
+(a gap it leaves is closed by the next step's touching instant).
 """
 
 from __future__ import annotations
@@ -219,11 +221,14 @@ class _RoundContact:
         self.tolerance = TOUCH_RTOL * max(size, pusher.radius)
         #: The largest overlap at the start that keeps the centre outside the outline [m].
         self.deepest_start = pusher.radius
+        #: The radius the pusher acts with [m]: its own, less a start's overlap (:meth:`start`).
+        self.reach = pusher.radius
 
     def start(self, pose: np.ndarray, allowed: float) -> None:
-        """Check the start at ``pose`` (:func:`_start_overlap`). An overlap stays: the contact
-        is the outline point nearest the centre, as for a pusher smaller by the overlap."""
-        _start_overlap(self, pose, allowed)
+        """Check the start at ``pose`` (:func:`_start_overlap`); an overlap makes the pusher act
+        as one smaller by as much (its centre outside the outline), as a flat pusher's sets its
+        face back."""
+        self.reach = self.pusher.radius - max(_start_overlap(self, pose, allowed), 0.0)
 
     def describe(self) -> tuple[str, str]:
         """The pusher in words, and how to start it outside the part (:func:`_start_overlap`)."""
@@ -232,8 +237,9 @@ class _RoundContact:
                 "allow an overlap below its radius with start_overlap)")  # fmt: skip
 
     def gap(self, pose: np.ndarray, t: float) -> float:
-        """Distance between the pusher's surface and the outline at time ``t`` [m]."""
-        return self.shape.nearest(_local(pose, self.pusher.position(t)))[2] - self.pusher.radius
+        """Distance between the pusher's surface (at its :attr:`reach`) and the outline at time
+        ``t`` [m]."""
+        return self.shape.nearest(_local(pose, self.pusher.position(t)))[2] - self.reach
 
     def state(self, pose: np.ndarray, t: float) -> _State:
         centre = _local(pose, self.pusher.position(t))
@@ -250,12 +256,18 @@ class _RoundContact:
         return _State(step, point[None, :], bearing, ())
 
     def advance(self, pose: np.ndarray, t: float, end: float, state: _State) -> np.ndarray:
-        """The pose at ``end`` [s] by the midpoint rule from ``state`` at ``t``."""
+        """The pose at ``end`` [s] by the midpoint rule from ``state`` at ``t``, moved out of
+        the pusher along the outline's normal where the step's error leaves them overlapping."""
         if state.step.mode == "separated":
             return pose
         rest = end - t
         midpoint = self.state(_compose(pose, state.step.twist, rest / 2), t + rest / 2)
-        return _compose(pose, midpoint.step.twist, rest)
+        moved = _compose(pose, midpoint.step.twist, rest)
+        _, outward, distance = self.shape.nearest(_local(moved, self.pusher.position(end)))
+        overlap = self.reach - distance
+        if overlap > 0.0:
+            moved[:2] -= overlap * (_rotation(moved[2]) @ outward)
+        return moved
 
 
 class _FaceContact:
