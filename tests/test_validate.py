@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from fixplan.errors import InvalidArgumentError
-from fixplan.io.cli import EXIT_NOT_HELD, EXIT_OK, main
+from fixplan.io.cli import EXIT_INVALID_INPUT, EXIT_NOT_HELD, EXIT_OK, main
 from fixplan.io.problem_file import load_problem
 from fixplan.planner.planner import Planner
 from fixplan.sim.validate import validate
@@ -61,6 +61,20 @@ def test_bad_requests_are_refused():
         validate(problem, plan, margin=1.5)
     with pytest.raises(InvalidArgumentError, match="unknown load case"):
         validate(problem, plan, loads=["nothing"])
+
+
+def test_an_export_over_its_problem_file_or_into_no_folder_is_refused_before_solving(
+    tmp_path, capsys
+):
+    problem = tmp_path / "pinch.toml"
+    problem.write_text((PROBLEMS / "hertz-pinch.toml").read_text(encoding="utf-8"), "utf-8")
+    before = problem.read_bytes()
+    assert main(["export", str(problem), "--mujoco", str(problem)]) == EXIT_INVALID_INPUT
+    assert "that is the problem file; name another file" in capsys.readouterr().err
+    assert problem.read_bytes() == before
+    missing = tmp_path / "nowhere" / "pinch.xml"
+    assert main(["export", str(problem), "--mujoco", str(missing)]) == EXIT_INVALID_INPUT
+    assert "does not exist; create it first" in capsys.readouterr().err
 
 
 def test_the_command_line_validates_exports_and_reports(tmp_path, capsys):

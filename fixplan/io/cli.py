@@ -522,12 +522,17 @@ def _check_output_folder(path: Path, option: str) -> None:
         raise InvalidArgumentError(f"{where}: cannot write in {ancestor} (permission denied)")
 
 
-def _check_output_file(path: Path, option: str) -> None:
-    """Fail before any work is done if the file ``path`` cannot be written."""
+def _check_output_file(
+    path: Path, option: str, *, not_over: tuple[Path, str] | None = None
+) -> None:
+    """Fail before any work is done if the file ``path`` cannot be written, or is the input
+    file ``not_over`` names (its path, and what it is in words)."""
     where = _output_path(path, option)
     folder = path.absolute().parent
     if path.is_dir():
         raise InvalidArgumentError(f"{where}: a folder of that name exists; name a file")
+    if not_over is not None and path.exists() and path.samefile(not_over[0]):
+        raise InvalidArgumentError(f"{where}: that is {not_over[1]}; name another file")
     if not folder.is_dir():
         raise InvalidArgumentError(f"{where}: the folder {folder} does not exist; create it first")
     if not os.access(folder, os.W_OK | os.X_OK):
@@ -616,6 +621,7 @@ def _planned(args):
 def _run_export(args: argparse.Namespace) -> tuple[int, str]:
     from fixplan.sim.mjcf import to_mjcf
 
+    _check_output_file(args.mujoco, "--mujoco", not_over=(args.file, "the problem file"))
     problem_file, plan, failed = _planned(args)
     if failed:
         return failed
@@ -824,11 +830,7 @@ def _run_fit(args: argparse.Namespace) -> tuple[int, str]:
     if args.report is not None:
         _check_output_folder(args.report, "--report")
     if args.save is not None:
-        _check_output_file(args.save, "--save")
-        if args.save.exists() and args.save.samefile(args.file):
-            raise InvalidArgumentError(
-                f"--save {args.save}: that is the measurements' file; name another for the fit"
-            )
+        _check_output_file(args.save, "--save", not_over=(args.file, "the measurements' file"))
     log.info("fitting a %s to %d measurements of %s", args.model, data.rows, args.file)
     try:
         result = fit(data.fit_loads, data.twists, normal_force=normal_force or 1.0, **options)
