@@ -59,6 +59,17 @@ def test_a_round_pusher_never_ends_a_step_inside_the_part(radius):
     assert errors[0] < 2e-4 and errors[0] / errors[1] > 14
 
 
+def test_a_round_pusher_wedging_into_a_notch_is_refused_with_time_and_place():
+    """A 10 mm pusher driven into a V-notch of a box touches both its faces: its single contact
+    does not model that (moved out of one face it went into the other, the part zig-zagging
+    step by step; before any put-back it went 11 mm into the part)."""
+    notched = Outline.polygon([[-0.05, -0.03], [0.05, -0.03], [0.05, 0.03], [-0.05, 0.03],
+                               [-0.05, 0.012], [-0.03, 0.0], [-0.05, -0.012]])  # fmt: skip
+    pusher = PointPusher(([-0.07, 0.004], [0.05, 0.003]), mu=0.3, radius=0.01)
+    with pytest.raises(GeometryError, match=r"at t = 0\.45 s .* wedges into a notch"):
+        push(SUPPORT, pusher, shape=notched, duration=2.0, steps=40)
+
+
 def test_a_pusher_that_misses_the_part_leaves_it_at_rest():
     pusher = PointPusher(([-0.1, 0.2], [0.05, 0.0]), mu=0.3, radius=0.005)
     trajectory = push(SUPPORT, pusher, shape=BLOCK, pose=(0.01, 0.0, 0.3), duration=1.0, steps=10)

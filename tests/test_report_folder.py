@@ -45,3 +45,15 @@ def test_a_report_that_fails_leaves_the_folder_as_it_was(tmp_path):
         raise RuntimeError("a figure failed")
     assert _files(folder) == before
     assert [p.name for p in tmp_path.iterdir()] == ["report"]  # (no staging folder left)
+
+
+def test_a_manifest_of_odd_names_or_a_folder_of_its_name_does_not_stop_a_report(tmp_path):
+    folder = tmp_path / "report"
+    folder.mkdir()
+    (folder / MANIFEST).write_text("x" * 300 + "\nreport.md\n", encoding="utf-8")  # (too long)
+    _report(folder, {"report.md": "new\n"})
+    assert (folder / "report.md").read_text(encoding="utf-8") == "new\n"
+    other = tmp_path / "other"
+    (other / MANIFEST).mkdir(parents=True)
+    _report(other, {"report.md": "new\n"})
+    assert (other / "report.md").is_file() and (other / MANIFEST).is_dir()

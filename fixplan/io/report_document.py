@@ -221,11 +221,14 @@ def staged_folder(directory: Path) -> Iterator[Path]:
         names = sorted(path.name for path in staging.iterdir())
         (staging / MANIFEST).write_text("".join(f"{name}\n" for name in names), "utf-8")
         if directory.is_dir():
-            stale = _reported(directory) - set(names)
-            for path in staging.iterdir():
-                os.replace(path, directory / path.name)
-            for name in stale:
+            # Stale files first: on a file system that ignores case, a figure renamed only in
+            # case is the same file as the new one.
+            for name in _reported(directory) - set(names):
                 (directory / name).unlink(missing_ok=True)
+            for name in names:
+                os.replace(staging / name, directory / name)
+            if not (directory / MANIFEST).is_dir():  # (the list last: a folder of its name stays)
+                os.replace(staging / MANIFEST, directory / MANIFEST)
         else:
             directory.parent.mkdir(parents=True, exist_ok=True)
             os.replace(staging, directory)
@@ -237,7 +240,8 @@ def staged_folder(directory: Path) -> Iterator[Path]:
 
 def _reported(directory: Path) -> set[str]:
     """The files of the report last written into ``directory`` (:data:`MANIFEST`) that are
-    still there: plain names of files in it (a name with a path in it is not one)."""
+    still there: plain names of files in it (a name with a path in it is not one; a name the
+    file system refuses, such as one too long, names none)."""
     try:
         listed = (directory / MANIFEST).read_text("utf-8").splitlines()
     except (OSError, UnicodeDecodeError):
@@ -245,5 +249,5 @@ def _reported(directory: Path) -> set[str]:
     return {
         name for name in listed
         if name not in ("", ".", "..", MANIFEST) and Path(name).name == name
-        and "\\" not in name and (directory / name).is_file()
+        and "\\" not in name and os.path.isfile(directory / name)
     }  # fmt: skip

@@ -395,7 +395,7 @@ class _Body:
             return None
         applied = self.applied(t, pose)
         safety = float(self.friction.safety_factor(applied))
-        if 1.0 - LEAVE_EXCESS < safety < np.inf:
+        if 1.0 - LEAVE_EXCESS < safety < 1.0 + LEAVE_EXCESS:
             applied = applied * ((1.0 + LEAVE_EXCESS) / safety)
         found = turn_from_rest(self.supports, self.friction, self.masses, applied)
         return None if found is None else self._turning(pose, *found)

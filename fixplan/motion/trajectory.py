@@ -257,16 +257,26 @@ class _RoundContact:
 
     def advance(self, pose: np.ndarray, t: float, end: float, state: _State) -> np.ndarray:
         """The pose at ``end`` [s] by the midpoint rule from ``state`` at ``t``, moved out of
-        the pusher along the outline's normal where the step's error leaves them overlapping."""
+        the pusher along the outline's normal where the step's error leaves them overlapping.
+        A pusher that overlaps the part still (it touches two faces of a notch at once, which
+        its single contact does not model) raises :class:`~fixplan.errors.GeometryError`."""
         if state.step.mode == "separated":
             return pose
         rest = end - t
         midpoint = self.state(_compose(pose, state.step.twist, rest / 2), t + rest / 2)
         moved = _compose(pose, midpoint.step.twist, rest)
-        _, outward, distance = self.shape.nearest(_local(moved, self.pusher.position(end)))
+        centre = self.pusher.position(end)
+        _, outward, distance = self.shape.nearest(_local(moved, centre))
         overlap = self.reach - distance
         if overlap > 0.0:
             moved[:2] -= overlap * (_rotation(moved[2]) @ outward)
+            if self.shape.nearest(_local(moved, centre))[2] < self.reach - self.tolerance:
+                raise GeometryError(
+                    f"at t = {end:.6g} s the PointPusher of radius {self.pusher.radius:g} m at "
+                    f"({centre[0]:g}, {centre[1]:g}) m wedges into a notch of the outline (it "
+                    "would touch two of its faces at once), which a round pusher's single "
+                    "contact does not model: push elsewhere, or with a larger pusher"
+                )
         return moved
 
 
