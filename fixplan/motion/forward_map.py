@@ -52,6 +52,7 @@ def forward_map(surface) -> ForwardMap:
         For a frictionless surface (no friction resists sliding: no quasi-static motion either)
         or one without a forward map (cones, pyramids, faceted ellipsoids).
     """
+    surface = exact_form(surface)
     if getattr(surface, "frictionless", False):
         raise InvalidArgumentError(
             f"{type(surface).__name__} is frictionless: give the support friction"
@@ -68,6 +69,15 @@ def forward_map(surface) -> ForwardMap:
         f"{type(surface).__name__} has no forward map load(twist): use the exact LimitSurface, "
         "a ContactSetSurface, an Ellipsoid, a FittedEllipsoid or an Exact model"
     )
+
+
+def exact_form(surface):
+    """``surface``, or the exact :class:`~fixplan.LimitSurface` it equals where it is another
+    kind that has one: a :class:`~fixplan.ContactSetSurface` of point contacts on a plane
+    (:meth:`~fixplan.ContactSetSurface.as_point_supports`)."""
+    convert = getattr(surface, "as_point_supports", None)
+    found = None if convert is None else convert()
+    return surface if found is None else found
 
 
 def _ellipsoid(inverse: np.ndarray, normal_force: float, safety_factor: Callable) -> ForwardMap:

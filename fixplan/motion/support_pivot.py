@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fixplan.models.exact import Exact
+from fixplan.motion.forward_map import exact_form
 from fixplan.surface.limit_surface import LimitSurface
 from fixplan.tolerances import CONTAINMENT_RTOL
 
@@ -50,8 +51,10 @@ class PointSupports:
 
     @classmethod
     def of(cls, surface) -> PointSupports | None:
-        """Those of ``surface`` (an exact :class:`~fixplan.LimitSurface` or an ``Exact`` model);
-        ``None`` for surfaces without them (patches, the smooth friction models)."""
+        """Those of ``surface`` (an exact :class:`~fixplan.LimitSurface`, an ``Exact`` model, or
+        a :class:`~fixplan.ContactSetSurface` of point contacts on a plane); ``None`` for
+        surfaces without them (patches, the smooth friction models)."""
+        surface = exact_form(surface)
         if isinstance(surface, Exact):
             surface = surface.surface
         if not isinstance(surface, LimitSurface) or not surface.has_facets:

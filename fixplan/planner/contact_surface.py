@@ -20,12 +20,17 @@ import cvxpy as cp
 import numpy as np
 
 from fixplan.errors import FixplanError, InvalidArgumentError
+from fixplan.models import PointCone
 from fixplan.planner.contact_models import contact_models
 from fixplan.planner.problem import Contact
+from fixplan.surface import pressure
+from fixplan.surface.limit_surface import LimitSurface
 from fixplan.surface.sphere import circle, fibonacci_sphere
 from fixplan.validation import unit_vector
 
 COMPONENTS = ("fx", "fy", "fz", "mx", "my", "mz")
+#: The sliding subspace of a part on a plane, in the order of a planar limit surface's loads.
+PLANAR = ("fx", "fy", "mz")
 _OPTIONS = {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9}
 
 
@@ -83,6 +88,7 @@ class ContactSetSurface:
         self._wrench = wrench
         self._support = cp.Problem(cp.Maximize(self._direction @ wrench), constraints)
         self._units = self._axis_extents()
+        self._points = _POINTS_UNKNOWN  # (see as_point_supports)
 
     @classmethod
     def from_plan(
@@ -98,6 +104,39 @@ class ContactSetSurface:
             )
         forces = np.clip(plan.normal_forces[:, plan.load_names.index(load)], 0.0, None)
         return cls(problem.contacts, forces, subspace)
+
+    def as_point_supports(self) -> LimitSurface | None:
+        """The same surface as the exact :class:`~fixplan.LimitSurface` of point supports, where
+        it is one: the subspace :data:`PLANAR` and every contact that takes friction a
+        :class:`~fixplan.models.PointCone` with its normal along ``±z`` (its friction the disk
+        of ``mu`` times its normal force, at its ``(x, y)``), at least two of them in distinct
+        places; ``None`` otherwise. The sliding dynamics use it (:mod:`fixplan.motion.sliding`):
+        its forward map is compiled rather than a conic solve per call, and a part turning about
+        one of its points is followed as such (the programs' friction at a point at rest is
+        any of its disk)."""
+        if self._points is _POINTS_UNKNOWN:
+            self._points = self._point_supports()
+        return self._points
+
+    def _point_supports(self) -> LimitSurface | None:
+        if self.subspace != PLANAR:
+            return None
+        places, friction = [], []
+        for contact, model, force in zip(self.contacts, self._models, self.normal_forces,
+                                         strict=True):  # fmt: skip
+            share = float(model.mu) * force if isinstance(model, PointCone) else np.nan
+            if share == 0.0:
+                continue  # (no friction: it takes no part in sliding)
+            if not (share > 0.0 and abs(contact.normal[2]) == 1.0):
+                return None
+            places.append(contact.position[:2])
+            friction.append(share)
+        try:
+            field = pressure.points(places, friction, centered=False)
+        except FixplanError:  # (fewer than two distinct places, or places too close to tell)
+            return None
+        total = float(np.sum(self.normal_forces))
+        return LimitSurface(field, mu=float(np.sum(friction)) / total, normal_force=total)
 
     def _solve(self, problem: cp.Problem) -> None:
         problem.solve(solver=cp.CLARABEL, **_OPTIONS)
@@ -188,6 +227,10 @@ class ContactSetSurface:
             load[index] = direction * self._units[index]
             points.append(load[index] * self.safety_factor(load))
         return np.array(points)
+
+
+#: What :meth:`ContactSetSurface.as_point_supports` holds before it is first asked.
+_POINTS_UNKNOWN = object()
 
 
 def _vector(name: str, value, size: int) -> np.ndarray:
