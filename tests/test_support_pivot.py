@@ -287,8 +287,30 @@ def test_a_set_of_point_contacts_slides_and_turns_about_one_as_its_points_do():
          None),
         (_point_contacts([[-0.04, 0.0], [0.04, 0.0]], [0.3, 0.0]), None),  # (one with friction)
         (_point_contacts([[-0.04, 0.0], [0.04, 0.0]], [0.3, 0.3]), ("fx", "mz", "fy")),
+        (_point_contacts([[-0.04, 0.0], [0.04, 0.0]], [0.3, 0.3], [[0, 0, 1.0], [1e-5, 0, 1.0]]),
+         None),
     ],
 )  # fmt: skip
 def test_other_contact_sets_are_no_surface_of_points(contacts, subspace):
     surface = ContactSetSurface(contacts, [1.0, 1.0], subspace or ("fx", "fy", "mz"))
     assert surface.as_point_supports() is None
+    tiny = ContactSetSurface(_point_contacts([[-0.04, 0.0], [0.04, 0.0]], [0.3, 0.3]), [1e-101] * 2)
+    assert tiny.as_point_supports() is None  # (friction below what a surface takes)
+
+
+def test_contacts_without_friction_are_left_out_and_those_at_one_place_merged():
+    """A frictionless locator and an unloaded support take no part; a clamp above a support
+    (same place, another height) adds its friction to that point's; a normal tilted by 1e-7 rad
+    counts as vertical."""
+    contacts = [
+        *_point_contacts([[-0.04, 0.0], [0.04, 0.0]], [0.3, 0.3], [[0, 0, 1.0], [1e-7, 0, 1.0]]),
+        *_point_contacts([[0.04, 0.0]], [0.5], [[0.0, 0.0, -1.0]]),
+        *_point_contacts([[0.0, 0.05]], [0.0], [[1.0, 0.0, 0.0]], model="point-pyramid"),
+        *_point_contacts([[0.0, -0.05]], [0.4]),
+    ]
+    surface = ContactSetSurface(contacts, [1.0, 2.0, 3.0, 4.0, 0.0])
+    points = surface.as_point_supports()
+    np.testing.assert_array_equal(points.point_supports[0], [[-0.04, 0.0], [0.04, 0.0]])
+    np.testing.assert_allclose(points.point_supports[1], [0.3, 0.6 + 1.5], rtol=1e-15)
+    for twist in np.random.default_rng(4).normal(size=(5, 3)) * [1.0, 1.0, 20.0]:
+        assert points.support(twist) == pytest.approx(surface.support(twist), rel=1e-8)

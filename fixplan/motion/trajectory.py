@@ -275,7 +275,8 @@ class _RoundContact:
                     f"at t = {end:.6g} s the PointPusher of radius {self.pusher.radius:g} m at "
                     f"({centre[0]:g}, {centre[1]:g}) m wedges into a notch of the outline (it "
                     "would touch two of its faces at once), which a round pusher's single "
-                    "contact does not model: push elsewhere, or with a larger pusher"
+                    "contact does not model: push elsewhere, or with a LinePusher (its face "
+                    "touches up to two points)"
                 )
         return moved
 

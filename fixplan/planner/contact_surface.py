@@ -31,6 +31,9 @@ from fixplan.validation import unit_vector
 COMPONENTS = ("fx", "fy", "fz", "mx", "my", "mz")
 #: The sliding subspace of a part on a plane, in the order of a planar limit surface's loads.
 PLANAR = ("fx", "fy", "mz")
+#: A point contact's normal counts as along ``±z`` within this of 1 in ``|n_z|`` (a tilt of
+#: 1.4e-6 rad, which shrinks its friction disk in the plane by 1e-12: a CAD model's rounding).
+PLANAR_RTOL = 1e-12
 _OPTIONS = {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9}
 
 
@@ -113,7 +116,9 @@ class ContactSetSurface:
         places; ``None`` otherwise. The sliding dynamics use it (:mod:`fixplan.motion.sliding`):
         its forward map is compiled rather than a conic solve per call, and a part turning about
         one of its points is followed as such (the programs' friction at a point at rest is
-        any of its disk)."""
+        any of its disk). Its points are the contacts' with friction, those at one place merged
+        into one: the indices of :attr:`~fixplan.motion.Sliding.pivots` are into its
+        :attr:`~fixplan.LimitSurface.point_supports`, not into the contacts."""
         if self._points is _POINTS_UNKNOWN:
             self._points = self._point_supports()
         return self._points
@@ -124,19 +129,18 @@ class ContactSetSurface:
         places, friction = [], []
         for contact, model, force in zip(self.contacts, self._models, self.normal_forces,
                                          strict=True):  # fmt: skip
-            share = float(model.mu) * force if isinstance(model, PointCone) else np.nan
-            if share == 0.0:
+            if force == 0.0 or model.frictionless:
                 continue  # (no friction: it takes no part in sliding)
-            if not (share > 0.0 and abs(contact.normal[2]) == 1.0):
+            if not isinstance(model, PointCone) or abs(contact.normal[2]) < 1.0 - PLANAR_RTOL:
                 return None
             places.append(contact.position[:2])
-            friction.append(share)
+            friction.append(float(model.mu) * force)
+        total = float(np.sum(self.normal_forces))
         try:
             field = pressure.points(places, friction, centered=False)
-        except FixplanError:  # (fewer than two distinct places, or places too close to tell)
-            return None
-        total = float(np.sum(self.normal_forces))
-        return LimitSurface(field, mu=float(np.sum(friction)) / total, normal_force=total)
+            return LimitSurface(field, mu=float(np.sum(friction)) / total, normal_force=total)
+        except FixplanError:  # (fewer than two distinct places, places too close to tell apart,
+            return None  # forces out of the surfaces' range)
 
     def _solve(self, problem: cp.Problem) -> None:
         problem.solve(solver=cp.CLARABEL, **_OPTIONS)
