@@ -223,6 +223,8 @@ class _RoundContact:
         self.deepest_start = pusher.radius
         #: The radius the pusher acts with [m]: its own, less a start's overlap (:meth:`start`).
         self.reach = pusher.radius
+        #: The last query of :meth:`_nearest` and its answer (a step's end is the next's start).
+        self._last_query: tuple = (None, None)
 
     def start(self, pose: np.ndarray, allowed: float) -> None:
         """Check the start at ``pose`` (:func:`_start_overlap`); an overlap makes the pusher act
@@ -239,11 +241,19 @@ class _RoundContact:
     def gap(self, pose: np.ndarray, t: float) -> float:
         """Distance between the pusher's surface (at its :attr:`reach`) and the outline at time
         ``t`` [m]."""
-        return self.shape.nearest(_local(pose, self.pusher.position(t)))[2] - self.reach
+        return self._nearest(pose, t)[2] - self.reach
+
+    def _nearest(self, pose: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray, float]:
+        """:meth:`~fixplan.motion.Outline.nearest` of the pusher's centre at time ``t`` [s] in
+        the part frame of ``pose`` (not to be changed: the last answer is kept)."""
+        centre = _local(pose, self.pusher.position(t))
+        key = centre.tobytes()
+        if self._last_query[0] != key:
+            self._last_query = (key, self.shape.nearest(centre))
+        return self._last_query[1]
 
     def state(self, pose: np.ndarray, t: float) -> _State:
-        centre = _local(pose, self.pusher.position(t))
-        point, outward, gap = self.shape.nearest(centre)
+        point, outward, gap = self._nearest(pose, t)
         velocity = _rotation(pose[2]).T @ self.pusher.velocity(t)
         if gap <= self.tolerance and not self.shape.enters(point, velocity):
             # A point pusher on the outline that moves along it (at a corner: along or out of
@@ -265,12 +275,12 @@ class _RoundContact:
         rest = end - t
         midpoint = self.state(_compose(pose, state.step.twist, rest / 2), t + rest / 2)
         moved = _compose(pose, midpoint.step.twist, rest)
-        centre = self.pusher.position(end)
-        _, outward, distance = self.shape.nearest(_local(moved, centre))
+        _, outward, distance = self._nearest(moved, end)
         overlap = self.reach - distance
         if overlap > 0.0:
             moved[:2] -= overlap * (_rotation(moved[2]) @ outward)
-            if self.shape.nearest(_local(moved, centre))[2] < self.reach - self.tolerance:
+            if self._nearest(moved, end)[2] < self.reach - self.tolerance:
+                centre = self.pusher.position(end)
                 raise GeometryError(
                     f"at t = {end:.6g} s the PointPusher of radius {self.pusher.radius:g} m at "
                     f"({centre[0]:g}, {centre[1]:g}) m wedges into a notch of the outline (it "
