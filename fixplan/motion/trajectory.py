@@ -31,6 +31,7 @@ import numpy as np
 
 from fixplan import validation
 from fixplan.errors import ConvergenceError, GeometryError, InvalidArgumentError
+from fixplan.motion.forward_map import exact_form
 from fixplan.motion.line_contact import line_push_step
 from fixplan.motion.outline import Outline
 from fixplan.motion.pushers import LinePusher, PointPusher
@@ -137,6 +138,7 @@ def push(
     """
     if not isinstance(shape, Outline):
         raise InvalidArgumentError(f"shape must be an Outline, got {type(shape).__name__}")
+    surface = exact_form(surface)  # (a set of point contacts: its points' compiled maps)
     if isinstance(pusher, PointPusher):
         contact = _RoundContact(surface, shape, pusher)
     elif isinstance(pusher, LinePusher):

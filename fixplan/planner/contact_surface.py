@@ -113,7 +113,7 @@ class ContactSetSurface:
         it is one: the subspace :data:`PLANAR` and every contact that takes friction a
         :class:`~fixplan.models.PointCone` with its normal along ``±z`` (its friction the disk
         of ``mu`` times its normal force, at its ``(x, y)``), at least two of them in distinct
-        places; ``None`` otherwise. The sliding dynamics use it (:mod:`fixplan.motion.sliding`):
+        places; ``None`` otherwise. The sliding dynamics and pushing trajectories use it:
         its forward map is compiled rather than a conic solve per call, and a part turning about
         one of its points is followed as such (the programs' friction at a point at rest is
         any of its disk). Its points are the contacts' with friction, those at one place merged
