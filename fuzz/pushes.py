@@ -52,7 +52,7 @@ def _run(seed: int) -> tuple[str, float] | None:
         return None
     shape, field = part
     surface = LimitSurface(field, mu=0.3, normal_force=5.0)
-    size = float(np.abs(shape.vertices).max()) if len(shape.vertices) else shape.radius
+    size = shape.size
     radius = float(rng.choice([0.0, rng.uniform(0.001, 0.02)]))
     start = np.array([-size - radius - rng.uniform(0.001, 0.02), rng.uniform(-size, size)])
     velocity = np.array([rng.uniform(0.02, 0.1), rng.uniform(-0.03, 0.03)])

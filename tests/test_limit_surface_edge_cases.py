@@ -95,6 +95,26 @@ def test_points_given_twice_have_the_surface_of_the_merged_field(rng, copies):
     np.testing.assert_allclose(repeated.support(twists), merged.support(twists), rtol=1e-14)
 
 
+def test_combined_point_sets_sharing_a_point_have_the_surface_of_the_merged_field(rng):
+    """Two point sets with a point in common, summed: that point is one support with the friction
+    of both (each copy failed its facet test: the inverse map did not converge on 52 of 300
+    loads)."""
+    first = LimitSurface(pressure.points([[0, 0], [0.1, 0]], centered=False), mu=0.5,
+                         normal_force=2.0)  # fmt: skip
+    second = LimitSurface(pressure.points([[0, 0], [-0.1, 0.05]], centered=False), mu=0.5,
+                          normal_force=2.0)  # fmt: skip
+    combined = LimitSurface.combine([first, second])
+    merged = LimitSurface(pressure.points([[0, 0], [0.1, 0], [-0.1, 0.05]], [2, 1, 1],
+                                          centered=False), mu=0.5, normal_force=4.0)  # fmt: skip
+    np.testing.assert_array_equal(combined.point_supports[0], merged.point_supports[0])
+    np.testing.assert_allclose(combined.point_supports[1], merged.point_supports[1], rtol=1e-15)
+    loads = rng.normal(size=(300, 3)) * merged._units
+    motions, safety = combined.motion_and_safety_factor(loads)
+    expected_motions, expected_safety = merged.motion_and_safety_factor(loads)
+    np.testing.assert_allclose(safety, expected_safety, rtol=1e-12)
+    np.testing.assert_allclose(motions, expected_motions, atol=1e-9)
+
+
 def test_friction_at_a_single_support_point_is_refused():
     field = pressure.points([[0.0, 0.0], [0.01, 0.0], [0.0, 0.01]])
     with pytest.raises(InvalidArgumentError, match="one support point only"):

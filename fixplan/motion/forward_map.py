@@ -60,8 +60,6 @@ def forward_map(surface) -> ForwardMap:
     if isinstance(surface, Ellipsoid | FittedEllipsoid):
         return _ellipsoid(np.linalg.inv(surface.load_matrix), surface.normal_force,
                           surface.safety_factor)  # fmt: skip
-    if isinstance(surface, Exact):
-        surface = surface.surface
     if all(hasattr(surface, name) for name in ("support", "load", "safety_factor")):
         return ForwardMap(support=surface.support, load=surface.load,
                           safety_factor=surface.safety_factor)  # fmt: skip
@@ -73,8 +71,11 @@ def forward_map(surface) -> ForwardMap:
 
 def exact_form(surface):
     """``surface``, or the exact :class:`~fixplan.LimitSurface` it equals where it is another
-    kind that has one: a :class:`~fixplan.ContactSetSurface` of point contacts on a plane
+    kind that has one: the :class:`~fixplan.models.Exact` model's, or a
+    :class:`~fixplan.ContactSetSurface` of point contacts on a plane
     (:meth:`~fixplan.ContactSetSurface.as_point_supports`)."""
+    if isinstance(surface, Exact):
+        return surface.surface
     convert = getattr(surface, "as_point_supports", None)
     found = None if convert is None else convert()
     return surface if found is None else found

@@ -54,6 +54,12 @@ class Outline:
         """A disk of ``radius`` [m] about the origin."""
         return cls(vertices=np.empty((0, 2)), radius=validation.positive_scalar("radius", radius))
 
+    @property
+    def size(self) -> float:
+        """The part's size [m]: its largest vertex coordinate, or a disk's radius (the scale of
+        the pushers' tolerances)."""
+        return float(np.abs(self.vertices).max()) if len(self.vertices) else self.radius
+
     def nearest(self, point) -> tuple[np.ndarray, np.ndarray, float]:
         """Closest outline point to ``point`` [m], the outward unit normal there, and the signed
         distance of ``point`` [m] (negative inside)."""

@@ -63,7 +63,7 @@ from scipy.optimize import brentq, root
 from fixplan import validation
 from fixplan.errors import ConvergenceError, InvalidArgumentError
 from fixplan.motion.forward_map import ForwardMap, forward_map
-from fixplan.motion.support_pivot import PointSupports, Turn, turn_from_rest, turning_twist
+from fixplan.motion.support_pivot import PointSupports, Turn, turn_from_rest
 from fixplan.tolerances import CONTAINMENT_RTOL, MAX_STEPS
 
 #: The body counts as stopped when its speed (with rotation counted at the radius of gyration)
@@ -263,10 +263,7 @@ def start_acceleration(surface, load, *, mass: float, inertia: float) -> np.ndar
     if supports is not None and friction.safety_factor(load) < 1.0 - CONTAINMENT_RTOL:
         found = turn_from_rest(supports, friction, masses, load)
         if found is not None:
-            _, turn, sense = found
-            return turn.acceleration(friction.load, load, 0.0, sense)[0] * turning_twist(
-                turn.point, 1.0
-            )
+            return found[3]
     return _start(friction, masses, load)
 
 
@@ -399,13 +396,13 @@ class _Body:
         if 1.0 - LEAVE_EXCESS < safety < 1.0 + LEAVE_EXCESS:
             applied = applied * ((1.0 + LEAVE_EXCESS) / safety)
         found = turn_from_rest(self.supports, self.friction, self.masses, applied)
-        return None if found is None else self._turning(pose, *found)
+        return None if found is None else self._turning(pose, *found[:3])
 
     def turn_at(self, t: float, state: np.ndarray, index: int) -> _Turning | None:
         """The turn about point support ``index``, now at rest in the sliding ``state`` (whose
         rate is not 0), where its friction keeps it still (``None``: it slips on)."""
         rate = float(state[5])
-        turn = Turn(self.supports.points[index], self.supports.capacity(index), self.masses)
+        turn = Turn(self.supports.points[index], float(self.supports.friction[index]), self.masses)
         sense = float(np.sign(rate))
         applied = self.applied(t, state[:3])
         if not turn.sticks(turn.acceleration(self.friction.load, applied, rate, sense)[1]):
@@ -473,11 +470,14 @@ class _Run:
         """How a slide ends where point support ``index`` came to rest at ``t``: at rest where
         the turn about it would be below the stopping speed already, turning about it where its
         friction holds it; ``None`` where it slips on."""
-        point = self.body.supports.points[index]
-        if abs(state[5]) * np.hypot(np.hypot(*point), self.gyration) <= self.stop_speed:
+        if abs(state[5]) * self._reach(self.body.supports.points[index]) <= self.stop_speed:
             return t, np.concatenate([state[:3], np.zeros(3)]), None
         turning = self.body.turn_at(t, state, index)
         return None if turning is None else (t, turning.state(state[2], state[5]), turning)
+
+    def _reach(self, point: np.ndarray) -> float:
+        """The speed [m/s] (:meth:`_Body.speed`) of a turn about ``point`` at 1 rad/s."""
+        return float(np.hypot(np.hypot(*point), self.gyration))
 
     def _slowest_point(self, state: np.ndarray, slipping: np.ndarray) -> tuple[int, float]:
         """The slowest point support in the sliding ``state`` but for those ``slipping``: its
@@ -495,7 +495,7 @@ class _Run:
         """:meth:`sliding` for a body turning about a point support: its angle and rate
         integrated, until it stops or the point slips (then ``turn`` is ``None``)."""
         body, turn = self.body, turning.turn
-        reach = float(np.hypot(np.hypot(*turn.point), self.gyration))
+        reach = self._reach(turn.point)
 
         def accelerated(t, y):  # (in the turn's sense until it stops: no flips)
             applied = body.applied(t, turning.pose(y[0]))
@@ -505,7 +505,7 @@ class _Run:
             return [y[1], accelerated(t, y)[0]]
 
         def slipping(t, y):
-            return float(np.hypot(*accelerated(t, y)[1])) - (1.0 + CONTAINMENT_RTOL) * turn.capacity
+            return turn.beyond_friction(accelerated(t, y)[1])
 
         stopping = _terminal(lambda t, y: turning.sense * y[1] * reach - self.stop_speed, -1.0)
         atol = np.array([self.position_atol / reach, STOP_ATOL * self.stop_speed / reach])
@@ -557,10 +557,12 @@ def _start(friction: ForwardMap, masses: np.ndarray, load: np.ndarray) -> np.nda
     scaled = load / root_masses
     size = float(np.linalg.norm(scaled))
 
+    def unbalanced(b: np.ndarray) -> np.ndarray:
+        """The scaled load that friction does not take at ``b`` (the same along its ray)."""
+        return scaled - np.asarray(friction.load(b / root_masses)) / root_masses
+
     def gradient(b: np.ndarray) -> np.ndarray:
-        if not np.any(b):
-            return -scaled
-        return b - scaled + np.asarray(friction.load(b / root_masses)) / root_masses
+        return b - unbalanced(b) if np.any(b) else -scaled
 
     guess = (1.0 - safety) * scaled
     # Powell's method, and from where it stopped Levenberg-Marquardt: on point supports, with
@@ -572,9 +574,9 @@ def _start(friction: ForwardMap, masses: np.ndarray, load: np.ndarray) -> np.nda
         if np.any(solution.x) and residual <= START_RTOL * size:
             return solution.x / root_masses
         guess = solution.x if np.any(solution.x) else guess
-    found, residual = _start_direction(friction, root_masses, scaled, guess)
+    found, residual = _start_direction(unbalanced, size, guess)
     if found is not None:
-        return found
+        return found / root_masses
     raise ConvergenceError(
         f"the starting motion under the load {load} was not found (root finding in the "
         f"acceleration and in its direction; optimality residual {residual:.3g} of the load)"
@@ -582,21 +584,17 @@ def _start(friction: ForwardMap, masses: np.ndarray, load: np.ndarray) -> np.nda
 
 
 def _start_direction(
-    friction: ForwardMap, root_masses: np.ndarray, scaled: np.ndarray, guess: np.ndarray
+    unbalanced: Callable, size: float, guess: np.ndarray
 ) -> tuple[np.ndarray | None, float]:
-    """The start of :func:`_start` from its direction ``u`` alone, from that of ``guess``:
+    """The start ``b`` of :func:`_start` from its direction ``u`` alone, from that of ``guess``:
     ``h`` is of degree 1, so ``∇h`` is the same along ``b = t u`` and the optimality condition
-    ``b - s + ∇h(b) = 0`` (``s = M^{-1/2} L``) says that ``s - ∇h(u)`` (the load friction does
-    not take, scaled) is along ``u``: ``t`` is its component along ``u``. Solved for ``u`` with
-    the length of ``u`` as a fourth condition, the equations are conditioned independently of
-    ``|b|``: for a load 1e-9 outside the surface ``b`` is 1e-9 of ``s``, and the root finders in
-    ``b`` stalled short of ``START_RTOL`` (3 of 247 fuzzed slides; the direction's came to
-    1e-16). Returns the acceleration (``None`` where not found) and the residual (gradient in
-    ``b``) relative to ``|s|``."""
-    size = float(np.linalg.norm(scaled))
-
-    def unbalanced(unit: np.ndarray) -> np.ndarray:
-        return scaled - np.asarray(friction.load(unit / root_masses)) / root_masses
+    ``b - s + ∇h(b) = 0`` (``s = M^{-1/2} L``, of size ``size``) says that ``unbalanced(u) = s
+    - ∇h(u)`` (the load friction does not take, scaled) is along ``u``: ``t`` is its component
+    along ``u``. Solved for ``u`` with the length of ``u`` as a fourth condition, the equations
+    are conditioned independently of ``|b|``: for a load 1e-9 outside the surface ``b`` is 1e-9
+    of ``s``, and the root finders in ``b`` stalled short of ``START_RTOL`` (3 of 247 fuzzed
+    slides; the direction's came to 1e-16). Returns ``b`` (``None`` where not found) and the
+    residual (gradient in ``b``) relative to ``size``."""
 
     def conditions(direction: np.ndarray) -> np.ndarray:
         length = float(np.linalg.norm(direction))
@@ -612,7 +610,7 @@ def _start_direction(
     along = float(rest @ unit)
     residual = float(np.linalg.norm(rest - along * unit)) / size
     if along > 0.0 and residual <= START_RTOL:
-        return along * unit / root_masses, residual
+        return along * unit, residual
     return None, residual
 
 

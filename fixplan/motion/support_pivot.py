@@ -28,7 +28,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fixplan.models.exact import Exact
 from fixplan.motion.forward_map import exact_form
 from fixplan.surface.limit_surface import LimitSurface
 from fixplan.tolerances import CONTAINMENT_RTOL
@@ -55,8 +54,6 @@ class PointSupports:
         a :class:`~fixplan.ContactSetSurface` of point contacts on a plane); ``None`` for
         surfaces without them (patches, the smooth friction models)."""
         surface = exact_form(surface)
-        if isinstance(surface, Exact):
-            surface = surface.surface
         if not isinstance(surface, LimitSurface) or not surface.has_facets:
             return None
         points, friction = surface.point_supports
@@ -66,14 +63,6 @@ class PointSupports:
         """``(P,)`` speeds [m/s] of the points under the body-frame ``twist``."""
         vx, vy, w = twist
         return np.hypot(vx - w * self.points[:, 1], vy + w * self.points[:, 0])
-
-    def capacity(self, index: int) -> float:
-        """The friction [N] that can keep point ``index`` still: its own and that of any other
-        support at the same place (to 1e-12 of the largest distance between them)."""
-        points = self.points
-        size = float(np.max(np.abs(points))) if points.size else 0.0
-        here = np.max(np.abs(points - points[index]), axis=1) <= 1e-12 * size
-        return float(self.friction[here].sum())
 
 
 def turning_twist(point: np.ndarray, sense: float) -> np.ndarray:
@@ -117,22 +106,28 @@ class Turn:
                           mass * (-alpha * px + squared * py) - fa_y + fo_y])  # fmt: skip
         return float(alpha), force
 
+    def beyond_friction(self, force: np.ndarray) -> float:
+        """How far ``force`` [N] exceeds what the point's friction can give (to
+        ``CONTAINMENT_RTOL``): above 0 it slips."""
+        return float(np.hypot(*force)) - (1.0 + CONTAINMENT_RTOL) * self.capacity
+
     def sticks(self, force: np.ndarray) -> bool:
-        """Whether the point's friction can give ``force`` (to ``CONTAINMENT_RTOL``)."""
-        return float(np.hypot(*force)) <= (1.0 + CONTAINMENT_RTOL) * self.capacity
+        """Whether the point's friction can give ``force``."""
+        return self.beyond_friction(force) <= 0.0
 
 
 def turn_from_rest(
     supports: PointSupports, others, masses: np.ndarray, applied: np.ndarray
-) -> tuple[int, Turn, float] | None:
+) -> tuple[int, Turn, float, np.ndarray] | None:
     """The turn about a point support in which a body at rest starts under the ``applied``
-    load, where it starts so: the point's index, the :class:`Turn` and its sense; ``None``
+    load, where it starts so: the point's index, the :class:`Turn`, its sense and the body's
+    acceleration ``(ax, ay, α)`` (body frame) as it starts; ``None``
     where no point stays still (the body slides, or stays at rest). ``others`` is the forward
     map (:class:`~fixplan.motion.forward_map.ForwardMap`). Of turns that all meet the
     conditions to rounding, the one of least ``½aᵀMa - L·a + h(a)``."""
     best, least = None, np.inf
     for index, point in enumerate(supports.points):
-        turn = Turn(point, supports.capacity(index), masses)
+        turn = Turn(point, float(supports.friction[index]), masses)
         for sense in (1.0, -1.0):
             alpha, force = turn.acceleration(others.load, applied, 0.0, sense)
             if alpha * sense <= 0.0 or not turn.sticks(force):
@@ -140,5 +135,5 @@ def turn_from_rest(
             a = alpha * turning_twist(point, 1.0)
             value = 0.5 * float(a @ (masses * a)) - float(applied @ a) + float(others.support(a))
             if value < least:
-                best, least = (index, turn, sense), value
+                best, least = (index, turn, sense, a), value
     return best

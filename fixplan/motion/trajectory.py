@@ -219,8 +219,7 @@ class _RoundContact:
 
     def __init__(self, surface, shape: Outline, pusher: PointPusher):
         self.surface, self.shape, self.pusher = surface, shape, pusher
-        size = float(np.abs(shape.vertices).max()) if len(shape.vertices) else shape.radius
-        self.tolerance = TOUCH_RTOL * max(size, pusher.radius)
+        self.tolerance = TOUCH_RTOL * max(shape.size, pusher.radius)
         #: The largest overlap at the start that keeps the centre outside the outline [m].
         self.deepest_start = pusher.radius
         #: The radius the pusher acts with [m]: its own, less a start's overlap (:meth:`start`).
@@ -299,8 +298,7 @@ class _FaceContact:
 
     def __init__(self, surface, shape: Outline, pusher: LinePusher):
         self.surface, self.shape, self.pusher = surface, shape, pusher
-        size = float(np.abs(shape.vertices).max()) if len(shape.vertices) else shape.radius
-        self.size, self.tolerance = size, TOUCH_RTOL * size
+        self.size, self.tolerance = shape.size, TOUCH_RTOL * shape.size
         self.deepest_start = math.inf  # (any overlap along the normal is a set-back)
         #: How far behind the pusher the face acts [m]: a start's overlap (:meth:`start`).
         self.set_back = 0.0

@@ -14,6 +14,7 @@ DPP problems compiled once (Clarabel); every query is a small conic solve.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 
 import cvxpy as cp
@@ -91,7 +92,6 @@ class ContactSetSurface:
         self._wrench = wrench
         self._support = cp.Problem(cp.Maximize(self._direction @ wrench), constraints)
         self._units = self._axis_extents()
-        self._points = _POINTS_UNKNOWN  # (see as_point_supports)
 
     @classmethod
     def from_plan(
@@ -119,10 +119,9 @@ class ContactSetSurface:
         any of its disk). Its points are the contacts' with friction, those at one place merged
         into one: the indices of :attr:`~fixplan.motion.Sliding.pivots` are into its
         :attr:`~fixplan.LimitSurface.point_supports`, not into the contacts."""
-        if self._points is _POINTS_UNKNOWN:
-            self._points = self._point_supports()
-        return self._points
+        return self._point_supports
 
+    @functools.cached_property
     def _point_supports(self) -> LimitSurface | None:
         if self.subspace != PLANAR:
             return None
@@ -231,10 +230,6 @@ class ContactSetSurface:
             load[index] = direction * self._units[index]
             points.append(load[index] * self.safety_factor(load))
         return np.array(points)
-
-
-#: What :meth:`ContactSetSurface.as_point_supports` holds before it is first asked.
-_POINTS_UNKNOWN = object()
 
 
 def _vector(name: str, value, size: int) -> np.ndarray:

@@ -162,3 +162,17 @@ def triangulate(vertices: np.ndarray) -> np.ndarray:
             raise GeometryError("polygon could not be triangulated; is it simple?")
     triangles.append(tuple(vertices[i] for i in remaining))
     return np.array(triangles, dtype=float)
+
+
+def merged_points(xy: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distinct points of ``xy`` ``(n, 2)`` [m] in order of first appearance, each with the sum
+    of the ``weights`` ``(n,)`` given to it."""
+    xy = xy + 0.0  # -0.0 and 0.0 are one coordinate
+    unique, first, inverse = np.unique(xy, axis=0, return_index=True, return_inverse=True)
+    if len(unique) == len(xy):
+        return xy, weights
+    order = np.argsort(first)
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    summed = np.bincount(rank[inverse.ravel()], weights=weights, minlength=len(unique))
+    return unique[order], summed

@@ -29,6 +29,7 @@ from fixplan import validation
 from fixplan.errors import GeometryError, InvalidArgumentError
 from fixplan.surface.geometry import (
     Pose,
+    merged_points,
     polygon_centroid,
     signed_area,
     simple_polygon,
@@ -378,7 +379,7 @@ def points(xy, weights=None, *, centered: bool = True) -> PointsField:
         if not np.any(w > 0.0):
             raise InvalidArgumentError("weights are all zero: the points carry no force")
     loaded = w > 0.0
-    xy_array, w = _merged(xy_array[loaded], w[loaded])
+    xy_array, w = merged_points(xy_array[loaded], w[loaded])
     w = w / w.sum()
     check_weight_ratio("weights", w)
     span = float(np.max(np.ptp(xy_array, axis=0))) if len(xy_array) > 1 else 0.0
@@ -435,20 +436,6 @@ def check_weight_ratio(name: str, weights: np.ndarray) -> None:
             "accurately beyond that ratio. Set so small weights to 0 (they carry no measurable "
             "force) or spread the load more evenly"
         )
-
-
-def _merged(xy: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Distinct points of ``xy`` ``(n, 2)`` [m] in order of first appearance, each with the sum
-    of the ``weights`` ``(n,)`` given to it."""
-    xy = xy + 0.0  # -0.0 and 0.0 are one coordinate
-    unique, first, inverse = np.unique(xy, axis=0, return_index=True, return_inverse=True)
-    if len(unique) == len(xy):
-        return xy, weights
-    order = np.argsort(first)
-    rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
-    summed = np.bincount(rank[inverse.ravel()], weights=weights, minlength=len(unique))
-    return unique[order], summed
 
 
 def grid(x, y, values, *, centered: bool = True) -> GridField:
