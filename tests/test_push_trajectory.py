@@ -84,7 +84,7 @@ def test_a_part_on_a_set_of_point_contacts_is_pushed_as_on_their_points():
     pusher = PointPusher(([-0.06, 0.01], [0.02, 0.0]), mu=0.2, radius=0.005)
     shape = Outline.rectangle(0.1, 0.08)
     moved = push(surface, pusher, shape=shape, duration=2.0, steps=100)
-    on_points = push(surface.as_point_supports(), pusher, shape=shape, duration=2.0, steps=100)
+    on_points = push(surface.as_limit_surface(), pusher, shape=shape, duration=2.0, steps=100)
     np.testing.assert_array_equal(moved.poses, on_points.poses)
     assert moved.poses[-1][0] > 0.03
 

@@ -253,9 +253,10 @@ def _point_contacts(places, mus, normals=None, model="point-cone"):
 
 def test_a_set_of_point_contacts_slides_and_turns_about_one_as_its_points_do():
     """Three point contacts (each its own mu and normal force, one normal pointing down) as a
-    ContactSetSurface: the LimitSurface of their points, with the conic solves' support and
-    forward map within 1e-8 on random twists, so a spinning part on them turns about one and
-    stops as the regularised integration of the points' friction says (3e-12 m and rad).
+    ContactSetSurface: the LimitSurface of their points, whose support and forward map are the
+    closed forms' (sums over the points) to 1e-14 and the conic programs' (what sets of other
+    models are queried with) to 1e-8 on random twists, so a spinning part on them turns about
+    one and stops as the regularised integration of the points' friction says (3e-12 m and rad).
     Before, each call of the forward map was a conic solve whose friction at a point at rest is
     any of its disk: after 100,000 evaluations (130 s) the integrator gave up."""
     places, mus, forces = (
@@ -265,12 +266,19 @@ def test_a_set_of_point_contacts_slides_and_turns_about_one_as_its_points_do():
     )
     normals = [[0.0, 0.0, -1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]]
     surface = ContactSetSurface(_point_contacts(places, mus, normals), forces)
-    points = surface.as_point_supports()
+    points = surface.as_limit_surface()
     np.testing.assert_array_equal(points.point_supports[0], places)
     np.testing.assert_allclose(points.point_supports[1], np.multiply(mus, forces), rtol=1e-15)
+    friction, (x, y) = np.multiply(mus, forces), np.transpose(places)
     for twist in np.random.default_rng(3).normal(size=(10, 3)) * [1.0, 1.0, 20.0]:
-        assert points.support(twist) == pytest.approx(surface.support(twist), rel=1e-8)
-        np.testing.assert_allclose(points.load(twist), surface.load(twist), rtol=0, atol=1e-8)
+        speeds = np.stack([twist[0] - twist[2] * y, twist[1] + twist[2] * x], axis=1)
+        fx, fy = (friction[:, None] * speeds / np.linalg.norm(speeds, axis=1, keepdims=True)).T
+        closed = np.array([fx.sum(), fy.sum(), (x * fy - y * fx).sum()])
+        assert surface.support(twist) == pytest.approx(closed @ twist, rel=1e-14)
+        np.testing.assert_allclose(surface.load(twist), closed, rtol=1e-14, atol=1e-15)
+        conic, wrench = surface._conic.support(twist)
+        assert points.support(twist) == pytest.approx(conic, rel=1e-8)
+        np.testing.assert_allclose(points.load(twist), wrench, rtol=0, atol=1e-8)
     moved = slide(surface, mass=MASS, inertia=INERTIA, twist0=[0.0, 0.0, 1.0], duration=0.05)
     assert [index for _, _, index in moved.pivots] == [1] and moved.stopped < 0.05
     supports = type("Points", (), {"point_supports": points.point_supports})
@@ -293,9 +301,9 @@ def test_a_set_of_point_contacts_slides_and_turns_about_one_as_its_points_do():
 )  # fmt: skip
 def test_other_contact_sets_are_no_surface_of_points(contacts, subspace):
     surface = ContactSetSurface(contacts, [1.0, 1.0], subspace or ("fx", "fy", "mz"))
-    assert surface.as_point_supports() is None
+    assert surface.as_limit_surface() is None
     tiny = ContactSetSurface(_point_contacts([[-0.04, 0.0], [0.04, 0.0]], [0.3, 0.3]), [1e-101] * 2)
-    assert tiny.as_point_supports() is None  # (friction below what a surface takes)
+    assert tiny.as_limit_surface() is None  # (friction below what a surface takes)
 
 
 def test_contacts_without_friction_are_left_out_and_those_at_one_place_merged():
@@ -309,7 +317,7 @@ def test_contacts_without_friction_are_left_out_and_those_at_one_place_merged():
         *_point_contacts([[0.0, -0.05]], [0.4]),
     ]
     surface = ContactSetSurface(contacts, [1.0, 2.0, 3.0, 4.0, 0.0])
-    points = surface.as_point_supports()
+    points = surface.as_limit_surface()
     np.testing.assert_array_equal(points.point_supports[0], [[-0.04, 0.0], [0.04, 0.0]])
     np.testing.assert_allclose(points.point_supports[1], [0.3, 0.6 + 1.5], rtol=1e-15)
     for twist in np.random.default_rng(4).normal(size=(5, 3)) * [1.0, 1.0, 20.0]:

@@ -72,11 +72,11 @@ def forward_map(surface) -> ForwardMap:
 def exact_form(surface):
     """``surface``, or the exact :class:`~fixplan.LimitSurface` it equals where it is another
     kind that has one: the :class:`~fixplan.models.Exact` model's, or a
-    :class:`~fixplan.ContactSetSurface` of point contacts on a plane
-    (:meth:`~fixplan.ContactSetSurface.as_point_supports`)."""
+    :class:`~fixplan.ContactSetSurface` of point contacts and exact patches on a plane
+    (:meth:`~fixplan.ContactSetSurface.as_limit_surface`)."""
     if isinstance(surface, Exact):
         return surface.surface
-    convert = getattr(surface, "as_point_supports", None)
+    convert = getattr(surface, "as_limit_surface", None)
     found = None if convert is None else convert()
     return surface if found is None else found
 

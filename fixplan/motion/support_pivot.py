@@ -51,7 +51,7 @@ class PointSupports:
     @classmethod
     def of(cls, surface) -> PointSupports | None:
         """Those of ``surface`` (an exact :class:`~fixplan.LimitSurface`, an ``Exact`` model, or
-        a :class:`~fixplan.ContactSetSurface` of point contacts on a plane); ``None`` for
+        a :class:`~fixplan.ContactSetSurface` with an exact form); ``None`` for
         surfaces without them (patches, the smooth friction models)."""
         surface = exact_form(surface)
         if not isinstance(surface, LimitSurface) or not surface.has_facets:

@@ -8,24 +8,32 @@ the limit surface of the whole fixture in that subspace. Wrench components are a
 origin: ``fx, fy, fz`` [N], ``mx, my, mz`` [N m]; twists pair with them as
 ``(vx, vy, vz, wx, wy, wz)``.
 
-The set is written with each contact's friction model as cvxpy constraints and queried with
-DPP problems compiled once (Clarabel); every query is a small conic solve.
+Point contacts and exact patches on a plane (subspace ``("fx", "fy", "mz")``, normals along
+``±z``) make up an exact :class:`~fixplan.LimitSurface`: the patches' surfaces placed in the
+part's frame (mirrored for a contact from above) and summed with the points'
+(:meth:`ContactSetSurface.as_limit_surface`), which the queries then ask. Other sets are written
+with each contact's friction model as cvxpy constraints and queried with DPP problems compiled
+once (Clarabel); every query is a small conic solve. (An exact model's constraints alone are
+its seed polytope, which holds its exact set: such a query is exact only on the plane.)
 """
 
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Sequence
 
 import cvxpy as cp
 import numpy as np
 
 from fixplan.errors import FixplanError, InvalidArgumentError
-from fixplan.models import PointCone
+from fixplan.models import Exact, PointCone
 from fixplan.planner.contact_models import contact_models
 from fixplan.planner.problem import Contact
 from fixplan.surface import pressure
+from fixplan.surface.geometry import Pose
 from fixplan.surface.limit_surface import LimitSurface
+from fixplan.surface.pressure import PointsField
 from fixplan.surface.sphere import circle, fibonacci_sphere
 from fixplan.validation import unit_vector
 
@@ -72,25 +80,7 @@ class ContactSetSurface:
         self.contacts = contacts
         self.normal_forces = forces
         self.subspace = tuple(subspace)
-        select = np.array([np.eye(6)[COMPONENTS.index(c)] for c in subspace])
-        models = contact_models(contacts)
-        parts = []
-        for contact, model in zip(contacts, models, strict=True):
-            parts.append(select @ contact.wrench_basis()[:, 1 : 1 + model.load_dimension])
-        self._maps = parts
-        self._models = models
-        dim = len(subspace)
-        self._direction = cp.Parameter(dim, name="direction")
-        loads = [cp.Variable(m.load_dimension) for m in models]
-        constraints = []
-        for load, model, fn in zip(loads, models, forces, strict=True):
-            constraints += model.constraints(load, float(fn))
-        wrench = sum(part @ load for part, load in zip(parts, loads, strict=True))
-        self._scale = cp.Variable(name="scale")
-        self._balance = wrench == self._scale * self._direction
-        self._gauge = cp.Problem(cp.Maximize(self._scale), [*constraints, self._balance])
-        self._wrench = wrench
-        self._support = cp.Problem(cp.Maximize(self._direction @ wrench), constraints)
+        self._models = contact_models(contacts)
         self._units = self._axis_extents()
 
     @classmethod
@@ -108,49 +98,58 @@ class ContactSetSurface:
         forces = np.clip(plan.normal_forces[:, plan.load_names.index(load)], 0.0, None)
         return cls(problem.contacts, forces, subspace)
 
-    def as_point_supports(self) -> LimitSurface | None:
-        """The same surface as the exact :class:`~fixplan.LimitSurface` of point supports, where
-        it is one: the subspace :data:`PLANAR` and every contact that takes friction a
-        :class:`~fixplan.models.PointCone` with its normal along ``±z`` (its friction the disk
-        of ``mu`` times its normal force, at its ``(x, y)``), at least two of them in distinct
-        places; ``None`` otherwise. The sliding dynamics and pushing trajectories use it:
-        its forward map is compiled rather than a conic solve per call, and a part turning about
-        one of its points is followed as such (the programs' friction at a point at rest is
-        any of its disk). Its points are the contacts' with friction, those at one place merged
-        into one: the indices of :attr:`~fixplan.motion.Sliding.pivots` are into its
+    def as_limit_surface(self) -> LimitSurface | None:
+        """The same surface as an exact :class:`~fixplan.LimitSurface`, where it is one: the
+        subspace :data:`PLANAR`, and every contact that takes friction with its normal along
+        ``±z`` and either a :class:`~fixplan.models.PointCone` (its friction the disk of ``mu``
+        times its normal force, at its ``(x, y)``) or an :class:`~fixplan.models.Exact` model
+        (its patch's exact surface at its normal force, placed in the plane by its frame:
+        mirrored where the normal is ``-z``); a patch, or point contacts in two or more places.
+        ``None`` otherwise. Where it exists, the queries of this class ask it (exact, and no
+        conic solve per call), and so do the sliding dynamics and pushing trajectories, which
+        follow a part turning about one of its points as such (the conic programs' friction at
+        a point at rest is any of its disk). Its point supports are the point contacts' with
+        friction and the patches', those at one place merged into one: the indices of
+        :attr:`~fixplan.motion.Sliding.pivots` are into its
         :attr:`~fixplan.LimitSurface.point_supports`, not into the contacts."""
-        return self._point_supports
+        return self._exact
 
     @functools.cached_property
-    def _point_supports(self) -> LimitSurface | None:
+    def _exact(self) -> LimitSurface | None:
         if self.subspace != PLANAR:
             return None
-        places, friction = [], []
+        places, friction, points_force, patches = [], [], 0.0, []
         for contact, model, force in zip(self.contacts, self._models, self.normal_forces,
                                          strict=True):  # fmt: skip
             if force == 0.0 or model.frictionless:
                 continue  # (no friction: it takes no part in sliding)
-            if not isinstance(model, PointCone) or abs(contact.normal[2]) < 1.0 - PLANAR_RTOL:
+            if abs(contact.normal[2]) < 1.0 - PLANAR_RTOL:
                 return None
-            places.append(contact.position[:2])
-            friction.append(float(model.mu) * force)
-        total = float(np.sum(self.normal_forces))
+            if isinstance(model, PointCone):
+                places.append(contact.position[:2])
+                friction.append(float(model.mu) * force)
+                points_force += float(force)
+            elif isinstance(model, Exact):
+                patches.append((model.surface, _plane_pose(contact), float(force)))
+            else:
+                return None
         try:
-            field = pressure.points(places, friction, centered=False)
-            return LimitSurface(field, mu=float(np.sum(friction)) / total, normal_force=total)
-        except FixplanError:  # (fewer than two distinct places, places too close to tell apart,
-            return None  # forces out of the surfaces' range)
+            parts = [surface.placed(pose, normal_force=force) for surface, pose, force in patches]
+            if places:
+                parts.append(_points_surface(places, friction, points_force, bool(patches)))
+        except FixplanError:  # (one point and no patch, places too close to tell apart, forces
+            return None  # out of the surfaces' range)
+        if not parts:
+            return None
+        return LimitSurface.combine(parts) if len(parts) > 1 else parts[0]
 
-    def _solve(self, problem: cp.Problem) -> None:
-        problem.solve(solver=cp.CLARABEL, **_OPTIONS)
-        if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
-            raise FixplanError(f"contact-set surface query failed: solver status {problem.status}")
+    @functools.cached_property
+    def _conic(self) -> _ConicPrograms:
+        """The conic programs of the queries, where there is no exact form (built once)."""
+        return _ConicPrograms(self.contacts, self._models, self.normal_forces, self.subspace)
 
     def _axis_extents(self) -> np.ndarray:
-        extents = []
-        for axis in np.eye(len(self.subspace)):
-            extents.append(self.support(axis))
-        extents = np.array(extents)
+        extents = np.array([self.support(axis) for axis in np.eye(len(self.subspace))])
         return np.where(extents > 0.0, extents, 1.0)
 
     # -- the LimitSurface API --------------------------------------------------------------------
@@ -160,34 +159,28 @@ class ContactSetSurface:
         direction = _vector("twist", twist, len(self.subspace))
         if not np.any(direction):
             return 0.0
-        unit, size = unit_vector(direction)  # (h is homogeneous: the solver sees a unit twist)
-        self._direction.value = unit
-        self._solve(self._support)
-        return float(self._support.value) * size
+        if self._exact is not None:
+            return float(self._exact.support(direction))
+        return self._conic.support(direction)[0]
 
     def load(self, twist) -> np.ndarray:
         """A wrench on the surface that sustains sliding with ``twist`` (a support point)."""
-        self.support(twist)
-        return np.asarray(self._wrench.value, dtype=float)
+        direction = _vector("twist", twist, len(self.subspace))
+        if self._exact is not None and np.any(direction):
+            return self._exact.load(direction)
+        return self._conic.support(direction)[1]
 
     def motion_and_safety_factor(self, load) -> tuple[np.ndarray, float]:
         """Sliding twist (unit, in the subspace) and safety factor of a subspace wrench."""
         wrench = _vector("load", load, len(self.subspace))
         if not np.any(wrench):
             return np.full(len(self.subspace), np.nan), float("inf")
-        # (The gauge is homogeneous: the solver sees the load at the scale of the axis extents.)
-        unit, size = unit_vector(wrench / self._units)
-        self._direction.value = unit * self._units
-        try:
-            self._solve(self._gauge)
-        except FixplanError:
-            if self._gauge.status in (cp.UNBOUNDED, cp.UNBOUNDED_INACCURATE):
-                return np.full(len(self.subspace), np.nan), float("inf")
-            raise
-        twist = -np.asarray(self._balance.dual_value, dtype=float)
-        twist = twist if twist @ wrench >= 0.0 else -twist
+        if self._exact is not None:
+            twist, safety = self._exact.motion_and_safety_factor(wrench)
+        else:
+            twist, safety = self._conic.motion_and_safety_factor(wrench, self._units)
         norm = np.linalg.norm(twist)
-        return (twist / norm if norm > 0 else twist), float(self._scale.value) / size
+        return (twist / norm if norm > 0 else twist), float(safety)
 
     def safety_factor(self, load) -> float:
         """Factor ``s`` with ``s * load`` on the surface (``inf`` if unbounded or zero)."""
@@ -230,6 +223,82 @@ class ContactSetSurface:
             load[index] = direction * self._units[index]
             points.append(load[index] * self.safety_factor(load))
         return np.array(points)
+
+
+def _plane_pose(contact: Contact) -> Pose:
+    """The placement of ``contact``'s frame in the plane ``z = const`` of a part sliding on it
+    (its normal along ``±z``): its x axis and position, mirrored where its normal is ``-z``."""
+    t1 = contact.frame[0]
+    return Pose(angle=math.atan2(t1[1], t1[0]), offset=(float(contact.position[0]),
+                float(contact.position[1])), mirrored=bool(contact.normal[2] < 0.0))  # fmt: skip
+
+
+def _points_surface(
+    places: list, friction: list, normal_force: float, beside_patches: bool
+) -> LimitSurface:
+    """The exact surface of point contacts at ``places`` ``(x, y)`` [m] with ``friction`` [N]
+    (``mu`` times each normal force) and ``normal_force`` [N] in all. One place alone has no
+    torsional friction (:func:`~fixplan.pressure.points` needs two), but stands
+    ``beside_patches`` as a support of its own. Raises :class:`~fixplan.errors.FixplanError`
+    where it is no surface."""
+    mu = float(np.sum(friction)) / normal_force
+    if not beside_patches or len({tuple(place) for place in np.asarray(places).tolist()}) > 1:
+        field = pressure.points(places, friction, centered=False)
+    else:
+        field = PointsField(xy=np.asarray(places[:1], dtype=float), weights=np.ones(1))
+    return LimitSurface(field, mu=mu, normal_force=normal_force)
+
+
+class _ConicPrograms:
+    """The set of contacts written with each contact's friction model as cvxpy constraints,
+    queried with DPP problems compiled once (Clarabel): the support function and the gauge of a
+    direction (a safety factor). Every query is a small conic solve."""
+
+    def __init__(self, contacts, models, forces, subspace):
+        select = np.array([np.eye(6)[COMPONENTS.index(c)] for c in subspace])
+        parts = [
+            select @ contact.wrench_basis()[:, 1 : 1 + model.load_dimension]
+            for contact, model in zip(contacts, models, strict=True)
+        ]
+        self._direction = cp.Parameter(len(subspace), name="direction")
+        loads = [cp.Variable(m.load_dimension) for m in models]
+        constraints = []
+        for load, model, fn in zip(loads, models, forces, strict=True):
+            constraints += model.constraints(load, float(fn))
+        self._wrench = sum(part @ load for part, load in zip(parts, loads, strict=True))
+        self._scale = cp.Variable(name="scale")
+        self._balance = self._wrench == self._scale * self._direction
+        self._gauge = cp.Problem(cp.Maximize(self._scale), [*constraints, self._balance])
+        self._support = cp.Problem(cp.Maximize(self._direction @ self._wrench), constraints)
+
+    def support(self, twist: np.ndarray) -> tuple[float, np.ndarray]:
+        """The support value of a twist and a wrench on the surface that sustains it."""
+        if not np.any(twist):
+            return 0.0, np.zeros(len(twist))
+        unit, size = unit_vector(twist)  # (h is homogeneous: the solver sees a unit twist)
+        self._direction.value = unit
+        _solve(self._support)
+        return float(self._support.value) * size, np.asarray(self._wrench.value, dtype=float)
+
+    def motion_and_safety_factor(self, wrench: np.ndarray, units: np.ndarray) -> tuple:
+        """The sliding twist (not normalised) and safety factor of a nonzero ``wrench``;
+        ``units``: the surface's axis extents, the scale at which the solver sees the load."""
+        unit, size = unit_vector(wrench / units)  # (the gauge is homogeneous)
+        self._direction.value = unit * units
+        try:
+            _solve(self._gauge)
+        except FixplanError:
+            if self._gauge.status in (cp.UNBOUNDED, cp.UNBOUNDED_INACCURATE):
+                return np.full(len(wrench), np.nan), float("inf")
+            raise
+        twist = -np.asarray(self._balance.dual_value, dtype=float)
+        return (twist if twist @ wrench >= 0.0 else -twist), float(self._scale.value) / size
+
+
+def _solve(problem: cp.Problem) -> None:
+    problem.solve(solver=cp.CLARABEL, **_OPTIONS)
+    if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
+        raise FixplanError(f"contact-set surface query failed: solver status {problem.status}")
 
 
 def _vector(name: str, value, size: int) -> np.ndarray:

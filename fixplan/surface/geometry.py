@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -14,7 +15,8 @@ from fixplan.errors import GeometryError
 class Pose:
     """Placement of a patch's local frame in the contact frame.
 
-    A local point ``q`` lies at ``R(angle) @ q + offset`` in the contact frame.
+    A local point ``q`` lies at ``R(angle) @ M @ q + offset`` in the contact frame, ``M`` the
+    identity, or for a ``mirrored`` pose the reflection ``diag(1, -1)``.
 
     Attributes
     ----------
@@ -22,21 +24,27 @@ class Pose:
         Rotation of the local x axis from the contact x axis [rad], counter-clockwise.
     offset : tuple[float, float]
         Position of the local origin in the contact frame [m].
+    mirrored : bool
+        Whether the local y axis is reversed before the rotation: the local frame seen from the
+        other side of the plane (a contact whose normal points the other way; the local frame's
+        counter-clockwise is the contact frame's clockwise).
     """
 
     angle: float = 0.0
     offset: tuple[float, float] = (0.0, 0.0)
+    mirrored: bool = False
 
     @property
     def rotation(self) -> np.ndarray:
-        """The 2x2 rotation matrix of ``angle``."""
+        """The 2x2 matrix ``R(angle) @ M`` of the local axes in the contact frame."""
         c, s = math.cos(self.angle), math.sin(self.angle)
-        return np.array([[c, -s], [s, c]])
+        turn = np.array([[c, -s], [s, c]])
+        return turn * np.array([1.0, -1.0]) if self.mirrored else turn
 
     @property
     def is_identity(self) -> bool:
         """Whether the local frame is the contact frame."""
-        return self.angle == 0.0 and self.offset == (0.0, 0.0)
+        return self.angle == 0.0 and self.offset == (0.0, 0.0) and not self.mirrored
 
     def apply(self, points: np.ndarray) -> np.ndarray:
         """Map local points ``(n, 2)`` [m] to the contact frame."""
@@ -44,7 +52,18 @@ class Pose:
 
     def shifted(self, dx: float, dy: float) -> Pose:
         """This pose followed by a translation by ``(dx, dy)`` [m]."""
-        return Pose(angle=self.angle, offset=(self.offset[0] + dx, self.offset[1] + dy))
+        return dataclasses.replace(self, offset=(self.offset[0] + dx, self.offset[1] + dy))
+
+    def then(self, outer: Pose) -> Pose:
+        """This pose followed by ``outer``: a local point placed by this pose, then by
+        ``outer`` (a mirror reverses the sense of the angles after it)."""
+        angle = outer.angle - self.angle if outer.mirrored else outer.angle + self.angle
+        offset = outer.apply(np.array([self.offset], dtype=float))[0]
+        return Pose(
+            angle=math.remainder(angle, 2.0 * math.pi),
+            offset=(float(offset[0]), float(offset[1])),
+            mirrored=self.mirrored != outer.mirrored,
+        )
 
     def rotated(self, angle: float, about: tuple[float, float]) -> Pose:
         """This pose followed by a rotation by ``angle`` [rad] about the point ``about`` [m]."""
@@ -53,6 +72,7 @@ class Pose:
         return Pose(
             angle=math.remainder(self.angle + angle, 2.0 * math.pi),
             offset=(c * ox - s * oy + about[0], s * ox + c * oy + about[1]),
+            mirrored=self.mirrored,
         )
 
 

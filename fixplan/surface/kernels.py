@@ -68,13 +68,16 @@ def twist_to_local(pose: Pose) -> np.ndarray:
     """Matrix ``T`` (3x3) with ``V_local = T @ V`` for a patch placed by ``pose``.
 
     The local origin ``t`` moves with ``v + w * J t`` (``J`` the 90-degree rotation); that
-    velocity in local axes is ``R^T (v + w J t)``; the angular rate is the same in both frames.
+    velocity in local axes is ``R^T (v + w J t)`` (``R`` the pose's :attr:`~Pose.rotation`); the
+    angular rate is the same in both frames, but for a mirrored pose, whose local frame turns
+    the other way: ``-w``.
     """
     rot = pose.rotation
     tx, ty = pose.offset
     transform = np.eye(3)
     transform[:2, :2] = rot.T
     transform[:2, 2] = rot.T @ np.array([-ty, tx])
+    transform[2, 2] = -1.0 if pose.mirrored else 1.0
     return transform
 
 

@@ -32,6 +32,7 @@ the same patch with ``mu = 1`` (:attr:`LimitSurface.friction_shape`), which shri
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Iterable
 
@@ -131,14 +132,7 @@ class LimitSurface:
         else:
             mu = validation.nonnegative_scalar("mu", mu)
             kernel, scale = _field_kernel(field), mu * normal_force
-        if normal_force < MIN_FRICTION_FORCE or 0.0 < scale < MIN_FRICTION_FORCE:
-            small = normal_force < MIN_FRICTION_FORCE
-            what, value = ("normal_force", normal_force) if small else ("mu * normal_force", scale)
-            hint = "" if small else " (give mu = 0 for a frictionless contact)"
-            raise InvalidArgumentError(
-                f"{what} = {value!r} N is below {MIN_FRICTION_FORCE:g} N, where the surface's "
-                f"arithmetic underflows{hint}"
-            )
+        _check_forces(normal_force, scale)
         self.field = field
         self._mu = mu
         self._normal_force = normal_force
@@ -187,6 +181,29 @@ class LimitSurface:
         combined._setup(kernel, 1.0, shape)
         return combined
 
+    def placed(self, pose: Pose, *, normal_force: float | None = None) -> LimitSurface:
+        """This surface with its frame placed by ``pose`` in another frame (a contact's surface
+        in the plane of the part it holds; the pose is mirrored where the contact faces the
+        other way), at ``normal_force`` [N] (default its own: the pressure keeps its shape, so
+        the friction scales with the force). Its loads are about the other frame's origin and
+        its point supports in that frame; its ``field`` is ``None``, its ``mu`` this one's
+        where that is a constant (``None`` for a function of this frame's coordinates)."""
+        if not isinstance(pose, Pose):
+            raise InvalidArgumentError(f"pose must be a Pose, got {type(pose).__name__}")
+        force = self._normal_force
+        if normal_force is not None:
+            force = validation.positive_scalar("normal_force", normal_force)
+        scale = self._scale * (force / self._normal_force)
+        _check_forces(force, scale)
+        placed = LimitSurface.__new__(LimitSurface)
+        placed.field = None
+        placed._mu = None if callable(self._mu) else self._mu
+        placed._normal_force = force
+        placed._parts = ()
+        shape = None if self._shape is None else self._shape.placed(pose, normal_force=force)
+        placed._setup(_posed(self._kernel, pose), scale, shape)
+        return placed
+
     # -- description ------------------------------------------------------------------------
 
     @property
@@ -232,7 +249,10 @@ class LimitSurface:
         return self._rho
 
     def __repr__(self) -> str:
-        what = f"{len(self._parts)} parts" if self._parts else type(self.field).__name__
+        if self._parts:
+            what = f"{len(self._parts)} parts"
+        else:
+            what = "placed" if self.field is None else type(self.field).__name__
         return (
             f"LimitSurface({what}, max_force={self.max_force:.6g} N, "
             f"max_moment={self.max_moment:.6g} N m)"
@@ -502,8 +522,28 @@ def _count(name: str, n: object) -> int:
     return int(n)
 
 
+def _check_forces(normal_force: float, scale: float) -> None:
+    """Refuse a normal force or friction force ``scale`` [N] below ``MIN_FRICTION_FORCE``."""
+    if normal_force < MIN_FRICTION_FORCE or 0.0 < scale < MIN_FRICTION_FORCE:
+        small = normal_force < MIN_FRICTION_FORCE
+        what, value = ("normal_force", normal_force) if small else ("mu * normal_force", scale)
+        hint = "" if small else " (give mu = 0 for a frictionless contact)"
+        raise InvalidArgumentError(
+            f"{what} = {value!r} N is below {MIN_FRICTION_FORCE:g} N, where the surface's "
+            f"arithmetic underflows{hint}"
+        )
+
+
 def _posed(kernel: SupportKernel, pose: Pose) -> SupportKernel:
-    return kernel if pose.is_identity else PosedKernel(kernel, pose)
+    """``kernel`` placed by ``pose``: points moved (no rounding from a twist transform), the
+    pose of a posed kernel composed with ``pose`` (it stays compiled), others posed."""
+    if pose.is_identity:
+        return kernel
+    if isinstance(kernel, PointSetKernel):
+        return dataclasses.replace(kernel, points=pose.apply(kernel.points))
+    if isinstance(kernel, PosedKernel):
+        return _posed(kernel.local, kernel.pose.then(pose))
+    return PosedKernel(kernel, pose)
 
 
 def _field_kernel(field: PressureField) -> SupportKernel:
@@ -525,7 +565,7 @@ def _field_kernel(field: PressureField) -> SupportKernel:
     elif isinstance(field, GridField):
         local, middle = _grid_kernel(field)
         offset = field.pose.apply(middle[None, :])[0]
-        return _posed(local, Pose(angle=field.pose.angle, offset=(offset[0], offset[1])))
+        return _posed(local, dataclasses.replace(field.pose, offset=(offset[0], offset[1])))
     elif isinstance(field, PointsField):  # placed directly: no rounding from a twist transform
         return PointSetKernel(field.pose.apply(field.xy), field.weights, discrete=True)
     elif isinstance(field, FunctionField):
