@@ -257,13 +257,6 @@ def test_the_report_gives_forces_safety_factors_and_motions_in_words(reports, so
     assert "/home" not in text and "/tmp" not in text  # no machine paths
 
 
-def test_the_contact_set_caption_says_exact_clamps_are_drawn_by_their_seed_polytopes(reports):
-    """The block's clamps are exact and its pads ellipsoids: the set has no exact form, and its
-    sections are conic solves over each exact clamp's seed polytope (which holds its set)."""
-    text = (reports[1][0] / "report.md").read_text(encoding="utf-8")
-    assert f"exact contacts ({', '.join(CLAMPS)}) are drawn by their seed polytopes" in text
-
-
 def test_an_infeasible_plan_is_reported_with_its_certificate_and_without_force_figures(
     infeasible,
 ):

@@ -51,7 +51,6 @@ from fixplan.io.report_document import (
     inline,
     staged_folder,
 )
-from fixplan.models import Exact
 from fixplan.motion.compliance import ComplianceResult
 from fixplan.planner.contact_surface import COMPONENTS, ContactSetSurface
 from fixplan.planner.plan import Plan
@@ -187,12 +186,6 @@ def _contact_set_figure(problem, plan, j, subspace, writer, figures_out, notes) 
     )
     if inaccurate:
         caption += f" The solver flagged {len(inaccurate)} section points as possibly inaccurate."
-    exact = [c.name for c in problem.contacts if c.model == "exact" or isinstance(c.model, Exact)]
-    if exact and surface.as_limit_surface() is None:
-        caption += (
-            f" The exact contacts ({', '.join(exact)}) are drawn by their seed polytopes (24 "
-            "tangent planes each), which hold their exact sets: the surface drawn is larger."
-        )
     figures_out.append(_Figure("contact-set.png", "contact-set limit surface", caption))
 
 

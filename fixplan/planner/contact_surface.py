@@ -13,8 +13,8 @@ Point contacts and exact patches on a plane (subspace ``("fx", "fy", "mz")``, no
 part's frame (mirrored for a contact from above) and summed with the points'
 (:meth:`ContactSetSurface.as_limit_surface`), which the queries then ask. Other sets are written
 with each contact's friction model as cvxpy constraints and queried with DPP problems compiled
-once (Clarabel); every query is a small conic solve. (An exact model's constraints alone are
-its seed polytope, which holds its exact set: such a query is exact only on the plane.)
+once (Clarabel): a support is one conic solve (the exact contacts' parts from their surfaces), a
+safety factor with exact contacts a few, which add tangent-plane cuts of their exact sets.
 """
 
 from __future__ import annotations
@@ -26,15 +26,17 @@ from collections.abc import Sequence
 import cvxpy as cp
 import numpy as np
 
-from fixplan.errors import FixplanError, InvalidArgumentError
+from fixplan.errors import ConvergenceError, FixplanError, InvalidArgumentError
 from fixplan.models import Exact, PointCone
 from fixplan.planner.contact_models import contact_models
+from fixplan.planner.cuts import CUT_MARGIN, DUAL_SPREAD, MAX_CUT_ROUNDS, around_twists
 from fixplan.planner.problem import Contact
 from fixplan.surface import pressure
 from fixplan.surface.geometry import Pose
 from fixplan.surface.limit_surface import LimitSurface
 from fixplan.surface.pressure import PointsField
 from fixplan.surface.sphere import circle, fibonacci_sphere
+from fixplan.tolerances import EXACT_CUT_RTOL
 from fixplan.validation import unit_vector
 
 COMPONENTS = ("fx", "fy", "fz", "mx", "my", "mz")
@@ -44,6 +46,9 @@ PLANAR = ("fx", "fy", "mz")
 #: 1.4e-6 rad, which shrinks its friction disk in the plane by 1e-12: a CAD model's rounding).
 PLANAR_RTOL = 1e-12
 _OPTIONS = {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9}
+#: Tangent-plane cuts kept per exact contact. (Sections of 72 points of the set of
+#: tests/test_report.py's block took 7.6, 7.4 and 7.2 solves per point with 16, 32 and 64.)
+CUT_POOL = 32
 
 
 class ContactSetSurface:
@@ -251,48 +256,118 @@ def _points_surface(
 
 class _ConicPrograms:
     """The set of contacts written with each contact's friction model as cvxpy constraints,
-    queried with DPP problems compiled once (Clarabel): the support function and the gauge of a
-    direction (a safety factor). Every query is a small conic solve."""
+    queried with DPP problems compiled once (Clarabel).
+
+    The support function of the sum is the sum of the contacts' supports: the exact contacts'
+    from their exact surfaces, the others' from one conic solve. The gauge of a direction (its
+    safety factor) is one conic problem over all contacts, each exact contact stated by its seed
+    polytope and tangent-plane cuts of its exact set, as the planner does
+    (:mod:`fixplan.planner.cuts`): after a solve, each exact contact's load outside its set by
+    more than ``EXACT_CUT_RTOL`` adds the plane at its own sliding twist
+    (:meth:`~fixplan.models.Exact.cut`) and four planes tilted around its twist in the solve's
+    impending motion, all tightened by ``CUT_MARGIN``, and the problem is solved again. Every
+    cut holds the exact set, so the safety factor is never above the exact one (below it by
+    about ``CUT_MARGIN``), and the cuts hold for every query: they are kept in a pool of
+    ``CUT_POOL`` rows per exact contact, the oldest replaced. The motion is the last solve's
+    multipliers.
+    """
 
     def __init__(self, contacts, models, forces, subspace):
         select = np.array([np.eye(6)[COMPONENTS.index(c)] for c in subspace])
-        parts = [
+        self._maps = [
             select @ contact.wrench_basis()[:, 1 : 1 + model.load_dimension]
             for contact, model in zip(contacts, models, strict=True)
         ]
         self._direction = cp.Parameter(len(subspace), name="direction")
-        loads = [cp.Variable(m.load_dimension) for m in models]
-        constraints = []
-        for load, model, fn in zip(loads, models, forces, strict=True):
-            constraints += model.constraints(load, float(fn))
-        self._wrench = sum(part @ load for part, load in zip(parts, loads, strict=True))
+        self._loads = [cp.Variable(m.load_dimension) for m in models]
+        #: The exact contacts with friction: (index, model, normal force [N], cut pool).
+        self._exact = [
+            (i, model, float(fn), cp.Parameter((CUT_POOL, 3), value=np.zeros((CUT_POOL, 3))))
+            for i, (model, fn) in enumerate(zip(models, forces, strict=True))
+            if isinstance(model, Exact) and fn > 0.0 and not model.frictionless
+        ]
+        self._next_cut = [0] * len(self._exact)
+        constraints, others, wrench = [], [], 0
+        exact = {i for i, *_ in self._exact}
+        for i, (load, model, fn) in enumerate(zip(self._loads, models, forces, strict=True)):
+            rows = model.constraints(load, float(fn))
+            constraints += rows
+            if i not in exact:
+                others += rows
+                wrench = wrench + self._maps[i] @ load
+        constraints += [pool @ self._loads[i] <= fn for i, _, fn, pool in self._exact]
+        self._others = wrench  # (the wrench of the contacts that are not exact; 0 if none)
+        self._wrench = sum(m @ load for m, load in zip(self._maps, self._loads, strict=True))
         self._scale = cp.Variable(name="scale")
         self._balance = self._wrench == self._scale * self._direction
         self._gauge = cp.Problem(cp.Maximize(self._scale), [*constraints, self._balance])
-        self._support = cp.Problem(cp.Maximize(self._direction @ self._wrench), constraints)
+        self._support = None
+        if others:
+            self._support = cp.Problem(cp.Maximize(self._direction @ wrench), others)
 
     def support(self, twist: np.ndarray) -> tuple[float, np.ndarray]:
         """The support value of a twist and a wrench on the surface that sustains it."""
+        value, wrench = 0.0, np.zeros(len(twist))
         if not np.any(twist):
-            return 0.0, np.zeros(len(twist))
+            return value, wrench
         unit, size = unit_vector(twist)  # (h is homogeneous: the solver sees a unit twist)
-        self._direction.value = unit
-        _solve(self._support)
-        return float(self._support.value) * size, np.asarray(self._wrench.value, dtype=float)
+        if self._support is not None:
+            self._direction.value = unit
+            _solve(self._support)
+            value, wrench = float(self._support.value), np.asarray(self._others.value, float)
+        for i, model, fn, _ in self._exact:
+            contact_twist = self._maps[i].T @ unit
+            if np.any(contact_twist):
+                scale = fn / model.surface.normal_force
+                value += scale * float(model.surface.support(contact_twist))
+                wrench = wrench + self._maps[i] @ (scale * model.surface.load(contact_twist))
+        return value * size, wrench
 
     def motion_and_safety_factor(self, wrench: np.ndarray, units: np.ndarray) -> tuple:
         """The sliding twist (not normalised) and safety factor of a nonzero ``wrench``;
         ``units``: the surface's axis extents, the scale at which the solver sees the load."""
         unit, size = unit_vector(wrench / units)  # (the gauge is homogeneous)
         self._direction.value = unit * units
-        try:
-            _solve(self._gauge)
-        except FixplanError:
-            if self._gauge.status in (cp.UNBOUNDED, cp.UNBOUNDED_INACCURATE):
-                return np.full(len(wrench), np.nan), float("inf")
-            raise
-        twist = -np.asarray(self._balance.dual_value, dtype=float)
-        return (twist if twist @ wrench >= 0.0 else -twist), float(self._scale.value) / size
+        for _ in range(MAX_CUT_ROUNDS):
+            try:
+                _solve(self._gauge)
+            except FixplanError:
+                if self._gauge.status in (cp.UNBOUNDED, cp.UNBOUNDED_INACCURATE):
+                    return np.full(len(wrench), np.nan), float("inf")
+                raise
+            twist = -np.asarray(self._balance.dual_value, dtype=float)
+            if not self._cut(twist):
+                twist = twist if twist @ wrench >= 0.0 else -twist
+                return twist, float(self._scale.value) / size
+        raise ConvergenceError(
+            f"contact-set surface: the loads of its exact contacts were still outside their "
+            f"exact sets after {MAX_CUT_ROUNDS} solves with tangent-plane cuts"
+        )
+
+    def _cut(self, motion: np.ndarray) -> bool:
+        """Add the cut of each exact contact's load outside its set, and the tangent plane at
+        its twist in the solve's impending ``motion``; whether any load was outside."""
+        added = False
+        for k, (i, model, fn, pool) in enumerate(self._exact):
+            load = np.asarray(self._loads[i].value, dtype=float)
+            if not np.any(load):
+                continue
+            planes, excess = model.cut(load[None, :] / fn)
+            if excess[0] <= EXACT_CUT_RTOL:
+                continue
+            rows = [planes[0]]
+            twist = self._maps[i].T @ motion
+            if np.any(twist):
+                twist = twist if twist @ load >= 0.0 else -twist  # (outward)
+                spread = np.array([DUAL_SPREAD * math.sqrt(excess[0])])
+                rows += list(model.planes(around_twists(twist[None, :], model.rho, spread)[:, 0]))
+            for row in rows:
+                values = pool.value.copy()
+                values[self._next_cut[k]] = row * (1.0 + CUT_MARGIN)
+                pool.value = values
+                self._next_cut[k] = (self._next_cut[k] + 1) % CUT_POOL
+            added = True
+        return added
 
 
 def _solve(problem: cp.Problem) -> None:

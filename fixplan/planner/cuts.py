@@ -152,7 +152,7 @@ class CutPool(ExactContacts):
                 moved = np.any(motion != 0.0, axis=1)
                 centres = np.where(moved[:, None], motion, centres)
                 spread = np.where(moved, DUAL_SPREAD * root, spread)
-            around = model.planes(_around(centres, model.rho, spread).reshape(-1, 3))
+            around = model.planes(around_twists(centres, model.rho, spread).reshape(-1, 3))
             new = [planes, *around.reshape(4, -1, 3)]
             order = _slots(self._used[:, e, cases], slack[:, e, cases] / forces[e, cases])
             for rows, slots in zip(new, order[: len(new)], strict=True):
@@ -182,7 +182,7 @@ def _slots(used: np.ndarray, slack: np.ndarray) -> np.ndarray:
     return np.lexsort((-slack, used), axis=0)
 
 
-def _around(twists: np.ndarray, rho: float, spread: np.ndarray) -> np.ndarray:
+def around_twists(twists: np.ndarray, rho: float, spread: np.ndarray) -> np.ndarray:
     """Four twists ``(4, K, 3)`` around each twist of ``twists`` ``(K, 3)``, tilted by ``±spread``
     along two directions normal to it in normalised coordinates ``(vx, vy, rho w)``."""
     scale = np.array([1.0, 1.0, rho])

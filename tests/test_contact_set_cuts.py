@@ -1,0 +1,74 @@
+"""Contact sets with exact contacts but no exact form (off the plane, or beside approximate
+models): supports from the exact surfaces, safety factors by tangent-plane cuts of the exact
+sets, against the exact form of the same contacts turned onto the plane and the laws of a
+Minkowski sum (additive supports, normality of the motion)."""
+
+import numpy as np
+import pytest
+
+from fixplan import Contact, ContactSetSurface, pressure
+
+#: The rotation taking y to z (and z to -y): fingers along y become contacts from below and above.
+TURN = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+FORCES = [10.0, 14.0]
+
+
+def fingers(turned: bool) -> list[Contact]:
+    """Two exact fingers squeezing along y (a disk and an off-centre rectangle, their x axes
+    tilted), or the same turned so that they squeeze along z."""
+    contacts = []
+    for name, side, patch in (("left", -1, pressure.disk(0.01)),
+                              ("right", 1, pressure.rectangle(0.02, 0.008).shifted(0.003, 0.0))):  # fmt: skip
+        position = np.array([0.01, side * 0.02, 0.005])
+        normal, axis = np.array([0.0, -side, 0.0]), np.array([1.0, 0.0, 0.3])
+        if turned:
+            position, normal, axis = TURN @ position, TURN @ normal, TURN @ axis
+        contacts.append(Contact(name=name, role="finger", position=position, normal=normal,
+                                mu=0.5, model="exact", patch=patch, axis=axis))  # fmt: skip
+    return contacts
+
+
+def test_exact_fingers_off_the_plane_are_cut_to_their_exact_sets():
+    """In the subspace (fx, fz, my) the fingers' set is that of the turned fingers in (fx, fy,
+    mz) with fy = -fz: an exact LimitSurface. Safety factors by cuts are never above it and at
+    most 2e-8 below (the cuts' margin is 1e-8); the motions, the last solve's multipliers, are
+    within 5e-4 (1.6e-4 at most on 40 random loads); supports are the surfaces' sums."""
+    across = ContactSetSurface(fingers(False), FORCES, ("fx", "fz", "my"))
+    flat = ContactSetSurface(fingers(True), FORCES, ("fx", "fy", "mz"))
+    assert across.as_limit_surface() is None and flat.as_limit_surface() is not None
+    flip = np.array([1.0, -1.0, 1.0])
+    rng = np.random.default_rng(0)
+    for load in rng.normal(size=(15, 3)) * across._units:
+        motion, safety = across.motion_and_safety_factor(load)
+        expected_motion, expected = flat.motion_and_safety_factor(load * flip)
+        assert expected * (1.0 - 2e-8) <= safety <= expected
+        np.testing.assert_allclose(motion * flip, expected_motion, rtol=0, atol=5e-4)
+    for twist in rng.normal(size=(10, 3)):
+        assert across.support(twist) == pytest.approx(flat.support(twist * flip), rel=1e-14)
+        np.testing.assert_allclose(across.load(twist) * flip, flat.load(twist * flip),
+                                   rtol=1e-13, atol=1e-15)  # fmt: skip
+
+
+def test_exact_contacts_beside_an_ellipsoid_obey_the_laws_of_a_minkowski_sum():
+    """An exact clamp from above, an ellipsoid pad and a pin: the support of the set is the sum
+    of each contact's alone, and at a safety factor's load ``s d`` its motion ``V`` is the
+    normal there: ``h(V) = s d·V`` (to 1e-7, the cuts' and solver's accuracy)."""
+    contacts = [
+        Contact(name="clamp", role="clamp", position=[0.0, 0.01, 0.02], normal=[0, 0, -1],
+                mu=0.4, model="exact", patch=pressure.rectangle(0.03, 0.01).shifted(0.004, 0)),
+        Contact(name="pad", role="support", position=[0.02, -0.01, 0.0], normal=[0, 0, 1],
+                mu=0.5, model="ellipsoid", patch=pressure.disk(0.012)),
+        Contact(name="pin", role="support", position=[-0.03, 0.0, 0.0], normal=[0, 0, 1],
+                mu=0.3, model="point-cone"),
+    ]  # fmt: skip
+    forces = [6.0, 9.0, 3.0]
+    both = ContactSetSurface(contacts, forces)
+    assert both.as_limit_surface() is None
+    alone = [ContactSetSurface([c], [f]) for c, f in zip(contacts, forces, strict=True)]
+    rng = np.random.default_rng(1)
+    for twist in rng.normal(size=(8, 3)) * [1.0, 1.0, 30.0]:
+        parts = sum(surface.support(twist) for surface in alone)
+        assert both.support(twist) == pytest.approx(parts, rel=1e-8)
+    for load in rng.normal(size=(8, 3)) * both._units:
+        motion, safety = both.motion_and_safety_factor(load)
+        assert both.support(motion) == pytest.approx(safety * load @ motion, rel=1e-7)
