@@ -32,17 +32,23 @@ def test_exact_fingers_off_the_plane_are_cut_to_their_exact_sets():
     """In the subspace (fx, fz, my) the fingers' set is that of the turned fingers in (fx, fy,
     mz) with fy = -fz: an exact LimitSurface. Safety factors by cuts are never above it and at
     most 2e-8 below (the cuts' margin is 1e-8); the motions, the last solve's multipliers, are
-    within 5e-4 (1.6e-4 at most on 40 random loads); supports are the surfaces' sums."""
+    within 1e-3 in normalised coordinates ``(v, rho w)`` (2.1e-4 at most, median 2.2e-5, on 40
+    random loads); supports are the surfaces' sums."""
     across = ContactSetSurface(fingers(False), FORCES, ("fx", "fz", "my"))
     flat = ContactSetSurface(fingers(True), FORCES, ("fx", "fy", "mz"))
     assert across.as_limit_surface() is None and flat.as_limit_surface() is not None
     flip = np.array([1.0, -1.0, 1.0])
+    normalised = np.array([1.0, 1.0, flat.as_limit_surface().characteristic_length])
+
+    def unit(twist):
+        return twist * normalised / np.linalg.norm(twist * normalised)
+
     rng = np.random.default_rng(0)
-    for load in rng.normal(size=(15, 3)) * across._units:
+    for load in rng.normal(size=(15, 3)) * [12.0, 12.0, 0.16]:
         motion, safety = across.motion_and_safety_factor(load)
         expected_motion, expected = flat.motion_and_safety_factor(load * flip)
         assert expected * (1.0 - 2e-8) <= safety <= expected
-        np.testing.assert_allclose(motion * flip, expected_motion, rtol=0, atol=5e-4)
+        np.testing.assert_allclose(unit(motion * flip), unit(expected_motion), rtol=0, atol=1e-3)
     for twist in rng.normal(size=(10, 3)):
         assert across.support(twist) == pytest.approx(flat.support(twist * flip), rel=1e-14)
         np.testing.assert_allclose(across.load(twist) * flip, flat.load(twist * flip),
