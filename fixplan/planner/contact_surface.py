@@ -29,14 +29,13 @@ import numpy as np
 from fixplan.errors import ConvergenceError, FixplanError, InvalidArgumentError
 from fixplan.models import Exact, PointCone
 from fixplan.planner.contact_models import contact_models
-from fixplan.planner.cuts import CUT_MARGIN, DUAL_SPREAD, MAX_CUT_ROUNDS, around_twists
+from fixplan.planner.cuts import MAX_CUT_ROUNDS, ContactCuts
 from fixplan.planner.problem import Contact
 from fixplan.surface import pressure
 from fixplan.surface.geometry import Pose
 from fixplan.surface.limit_surface import LimitSurface
 from fixplan.surface.pressure import PointsField
 from fixplan.surface.sphere import circle, fibonacci_sphere
-from fixplan.tolerances import EXACT_CUT_RTOL
 from fixplan.validation import unit_vector
 
 COMPONENTS = ("fx", "fy", "fz", "mx", "my", "mz")
@@ -280,13 +279,12 @@ class _ConicPrograms:
         ]
         self._direction = cp.Parameter(len(subspace), name="direction")
         self._loads = [cp.Variable(m.load_dimension) for m in models]
-        #: The exact contacts with friction: (index, model, normal force [N], cut pool).
+        #: The exact contacts with friction: (index, model, normal force [N], their cuts).
         self._exact = [
-            (i, model, float(fn), cp.Parameter((CUT_POOL, 3), value=np.zeros((CUT_POOL, 3))))
+            (i, model, float(fn), ContactCuts(model, CUT_POOL))
             for i, (model, fn) in enumerate(zip(models, forces, strict=True))
             if isinstance(model, Exact) and fn > 0.0 and not model.frictionless
         ]
-        self._next_cut = [0] * len(self._exact)
         constraints, others, wrench = [], [], 0
         exact = {i for i, *_ in self._exact}
         for i, (load, model, fn) in enumerate(zip(self._loads, models, forces, strict=True)):
@@ -295,7 +293,7 @@ class _ConicPrograms:
             if i not in exact:
                 others += rows
                 wrench = wrench + self._maps[i] @ load
-        constraints += [pool @ self._loads[i] <= fn for i, _, fn, pool in self._exact]
+        constraints += [cuts.constraint(self._loads[i], fn) for i, _, fn, cuts in self._exact]
         self._others = wrench  # (the wrench of the contacts that are not exact; 0 if none)
         self._wrench = sum(m @ load for m, load in zip(self._maps, self._loads, strict=True))
         self._scale = cp.Variable(name="scale")
@@ -345,28 +343,12 @@ class _ConicPrograms:
         )
 
     def _cut(self, motion: np.ndarray) -> bool:
-        """Add the cut of each exact contact's load outside its set, and the tangent plane at
-        its twist in the solve's impending ``motion``; whether any load was outside."""
+        """Cut off each exact contact's load outside its set (:meth:`ContactCuts.add`, about
+        its twist in the solve's impending ``motion``); whether any was."""
         added = False
-        for k, (i, model, fn, pool) in enumerate(self._exact):
+        for i, _, fn, cuts in self._exact:
             load = np.asarray(self._loads[i].value, dtype=float)
-            if not np.any(load):
-                continue
-            planes, excess = model.cut(load[None, :] / fn)
-            if excess[0] <= EXACT_CUT_RTOL:
-                continue
-            rows = [planes[0]]
-            twist = self._maps[i].T @ motion
-            if np.any(twist):
-                twist = twist if twist @ load >= 0.0 else -twist  # (outward)
-                spread = np.array([DUAL_SPREAD * math.sqrt(excess[0])])
-                rows += list(model.planes(around_twists(twist[None, :], model.rho, spread)[:, 0]))
-            for row in rows:
-                values = pool.value.copy()
-                values[self._next_cut[k]] = row * (1.0 + CUT_MARGIN)
-                pool.value = values
-                self._next_cut[k] = (self._next_cut[k] + 1) % CUT_POOL
-            added = True
+            added |= cuts.add(load, fn, self._maps[i].T @ motion)
         return added
 
 
