@@ -51,13 +51,11 @@ Loading happens in two steps.
 Each step is the minimum of the complementary energy of the springs, a convex program solved by
 :mod:`fixplan.motion.contact_springs`; elastic steps are then polished to be exact.
 
-An ``exact`` friction model is stated there by its seed polytope (24 tangent planes of the exact
-set, :meth:`~fixplan.models.Exact.constraints`), which holds the exact set: the first slip is
-exact (each contact's own exact safety factor), but sliding contacts' friction loads lie on the
-polytope, up to :attr:`~fixplan.models.Exact.constraint_error` outside the exact set, so the
-collapse comes out too large (a warning says so). Cutting the polytope down to the exact set at
-every step, as the planner does, was tried: the friction bounds' fixed point then failed to
-settle along whole stretches of the ramp.
+An ``exact`` friction model is stated in a step by the ellipsoid that osculates its exact set
+where the step's friction load meets it, moved until the step is the exact set's (see
+:class:`~fixplan.motion.contact_springs.ContactQP`). One with facets (point supports), where no
+ellipsoid osculates, is stated by its seed polytope (24 tangent planes, which hold the exact
+set): its sliding friction can lie outside the exact set, and a warning says so.
 """
 
 from __future__ import annotations
@@ -288,17 +286,17 @@ def analyse(
 
 
 def _warn_of_exact_models(names, models) -> None:
-    """Warn where contacts with friction have exact models: the steps state their seed
-    polytopes (see the module doc)."""
+    """Warn where contacts with friction have exact models with facets: the steps state their
+    seed polytopes (see the module doc)."""
     exact = [(n, m) for n, m in zip(names, models, strict=True)
-             if isinstance(m, Exact) and not m.frictionless]  # fmt: skip
+             if isinstance(m, Exact) and not m.frictionless and m.surface.has_facets]  # fmt: skip
     if exact:
         gap = max(m.constraint_error for _, m in exact)
         warnings.warn(
             f"compliant analysis: the exact friction models of {', '.join(n for n, _ in exact)} "
-            f"are stated by their seed polytopes, up to {gap:.1%} outside the exact sets: the "
-            "first slip is exact, but a sliding contact's friction can exceed its exact set and "
-            "the collapse comes out too large (pyramid models, inscribed, hold it from inside)",
+            f"have facets (point supports) and are stated by their seed polytopes, up to "
+            f"{gap:.1%} outside the exact sets: the first slip is exact, but a sliding "
+            "contact's friction can exceed its exact set and the collapse come out too large",
             stacklevel=3,
         )
 
