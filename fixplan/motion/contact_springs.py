@@ -45,8 +45,8 @@ import numpy as np
 from fixplan.errors import ConvergenceError, InvalidArgumentError
 from fixplan.models import Exact
 from fixplan.planner.direct_solve import INFEASIBLE, DirectSolver
+from fixplan.planner.osculating_contact import MAX_OSCULATING_ROUNDS, OsculatingContact
 from fixplan.planner.parameters import assign
-from fixplan.tolerances import EXACT_CUT_RTOL
 
 #: A polished solution is accepted when its equilibrium residual, negative normal forces and
 #: closed gaps of lifted contacts are below this fraction of the step's force scale.
@@ -58,16 +58,6 @@ LIFT_RTOL = 1e-7
 #: Friction bound, in units of the force scale, of a contact whose friction is not limited (an
 #: elastic step): far above any force a step can produce, so the constraint stays inactive.
 UNLIMITED = 1e4
-
-#: Most solves of one step while its exact contacts' ellipsoids move (see :class:`_Osculating`).
-MAX_OSCULATING_ROUNDS = 30
-
-#: An exact contact's load counts as on its ellipsoid within this fraction of it.
-ACTIVE_RTOL = 1e-7
-
-#: The load is at the point its ellipsoid osculates within this (normalised by the surface's
-#: extents, per unit normal force).
-SETTLED_RTOL = 1e-7
 
 #: Most re-solves while dropping the tangential springs of lifted contacts, per contact.
 MAX_LIFT_ROUNDS_PER_CONTACT = 2
@@ -144,7 +134,8 @@ class ContactQP:
         pressing = [4 * i for i in range(count) if not fixed[4 * i]]
         if pressing:
             constraints.append(forces[pressing] >= 0)
-        self._osculating: dict[int, _Osculating] = {}
+        self._osculating: dict[int, OsculatingContact] = {}
+        self._case: str | None = None  # (the load case of the last step)
         for i, model in enumerate(models):
             if model.frictionless or fixed[4 * i + 1 : 4 * i + 4].all():
                 continue
@@ -154,7 +145,7 @@ class ContactQP:
             else:
                 load = cp.hstack([u[p] * forces[4 * i + p] for p in (1, 2)])
             if isinstance(model, Exact) and not model.surface.has_facets:
-                self._osculating[i] = _Osculating(model)
+                self._osculating[i] = OsculatingContact(model)
                 constraints.append(self._osculating[i].constraint(load, self.bound[i]))
             else:
                 constraints += model.constraints(load, self.bound[i])
@@ -173,10 +164,18 @@ class ContactQP:
         assign(self.reference, np.ravel(reference) / self.units)
         assign(self.wrench, np.asarray(wrench, float) / self.rows)
         assign(self.bound, np.maximum(bound, 0.0) / self.scale)
+        for ellipsoid in self._osculating.values():
+            ellipsoid.start()
+            if case != self._case:  # (each load case from the same start: its answer is its own)
+                ellipsoid.reset()
+        self._case = case
         for _ in range(MAX_OSCULATING_ROUNDS):
             forces, delta = self._solve_once(case)
             bounds = self.bound.value * self.scale
-            moved = [e.follow(forces[i, 1:4], bounds[i]) for i, e in self._osculating.items()]
+            try:
+                moved = [e.follow(forces[i, 1:4], bounds[i]) for i, e in self._osculating.items()]
+            except ConvergenceError as exc:
+                raise InaccurateStepError(f"load case {case!r}: {exc}") from exc
             if not any(moved):
                 return forces, delta
         raise InaccurateStepError(
@@ -257,54 +256,6 @@ class ContactQP:
         """The displacement from the multipliers of equilibrium: the cost is ``2 / w`` times the
         complementary energy in scaled forces, so ``Δδ = w y / 2`` per scaled row."""
         return 0.5 * self._energy * np.asarray(dual, float) / self.rows
-
-
-class _Osculating:
-    """An exact contact's friction set in the QP: the ellipsoid ``‖R ℓ‖ <= g`` (``R`` a
-    Parameter, per unit normal force) that osculates its exact set, moved until the step's
-    load is inside the exact set and, where it is on its ellipsoid, at the point the ellipsoid
-    osculates (there the two share their point, tangent plane and curvature, so the step meets
-    the exact QP's optimality conditions)."""
-
-    def __init__(self, model: Exact):
-        import cvxpy as cp
-
-        self.model = model
-        self._units = model._units()  # (first the axis ellipsoid, through the axis points)
-        self.factor = cp.Parameter((3, 3), value=np.diag(1.0 / self._units))
-        self._point: np.ndarray | None = None  # (per unit normal force)
-
-    def constraint(self, load, bound):
-        """The ellipsoid on the friction ``load`` (3 entries) at the normal force ``bound``."""
-        import cvxpy as cp
-
-        return cp.norm(self.factor @ load) <= bound
-
-    def safety_factor(self, load: np.ndarray, normal_force: float) -> float:
-        """The safety factor of ``load`` in the ellipsoid at ``normal_force`` [N]."""
-        size = np.linalg.norm(self.factor.value @ load)
-        return normal_force / size if size > 0.0 else np.inf
-
-    def follow(self, load: np.ndarray, bound: float) -> bool:
-        """Move the ellipsoid where the step's friction ``load`` ``(3,)`` [N, N, N m] at the
-        normal force ``bound`` [N] asks; whether it moved."""
-        if bound <= 0.0 or not np.any(load):
-            return False
-        per_unit = load / bound
-        pressed = np.linalg.norm(self.factor.value @ per_unit) >= 1.0 - ACTIVE_RTOL
-        settled = (
-            self._point is not None
-            and np.linalg.norm((per_unit - self._point) / self._units) <= SETTLED_RTOL
-        )
-        if pressed and settled:
-            return False
-        excess, points, factors = self.model.osculating(per_unit[None, :])
-        if not pressed and excess[0] <= EXACT_CUT_RTOL:
-            return False
-        if not np.all(np.isfinite(factors)):
-            raise InaccurateStepError("an exact contact's set has no curvature at its load")
-        self.factor.value, self._point = factors[0], points[0]
-        return True
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -14,7 +14,7 @@ part's frame (mirrored for a contact from above) and summed with the points'
 (:meth:`ContactSetSurface.as_limit_surface`), which the queries then ask. Other sets are written
 with each contact's friction model as cvxpy constraints and queried with DPP problems compiled
 once (Clarabel): a support is one conic solve (the exact contacts' parts from their surfaces), a
-safety factor with exact contacts a few, which add tangent-plane cuts of their exact sets.
+safety factor with exact contacts a few, which move ellipsoids that osculate their exact sets.
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ import numpy as np
 from fixplan.errors import ConvergenceError, FixplanError, InvalidArgumentError
 from fixplan.models import Exact, PointCone
 from fixplan.planner.contact_models import contact_models
-from fixplan.planner.cuts import MAX_CUT_ROUNDS, ContactCuts
+from fixplan.planner.osculating_contact import MAX_OSCULATING_ROUNDS, OsculatingContact
 from fixplan.planner.problem import Contact
 from fixplan.surface import pressure
 from fixplan.surface.geometry import Pose
@@ -45,9 +45,6 @@ PLANAR = ("fx", "fy", "mz")
 #: 1.4e-6 rad, which shrinks its friction disk in the plane by 1e-12: a CAD model's rounding).
 PLANAR_RTOL = 1e-12
 _OPTIONS = {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9}
-#: Tangent-plane cuts kept per exact contact. (Sections of 72 points of the set of
-#: tests/test_report.py's block took 7.6, 7.4 and 7.2 solves per point with 16, 32 and 64.)
-CUT_POOL = 32
 
 
 class ContactSetSurface:
@@ -259,16 +256,12 @@ class _ConicPrograms:
 
     The support function of the sum is the sum of the contacts' supports: the exact contacts'
     from their exact surfaces, the others' from one conic solve. The gauge of a direction (its
-    safety factor) is one conic problem over all contacts, each exact contact stated by its seed
-    polytope and tangent-plane cuts of its exact set, as the planner does
-    (:mod:`fixplan.planner.cuts`): after a solve, each exact contact's load outside its set by
-    more than ``EXACT_CUT_RTOL`` adds the plane at its own sliding twist
-    (:meth:`~fixplan.models.Exact.cut`) and four planes tilted around its twist in the solve's
-    impending motion, all tightened by ``CUT_MARGIN``, and the problem is solved again. Every
-    cut holds the exact set, so the safety factor is never above the exact one (below it by
-    about ``CUT_MARGIN``), and the cuts hold for every query: they are kept in a pool of
-    ``CUT_POOL`` rows per exact contact, the oldest replaced. The motion is the last solve's
-    multipliers.
+    safety factor) is one conic problem over all contacts, each smooth exact contact stated by
+    the ellipsoid that osculates its exact set where its load meets it, solved again with the
+    ellipsoids moved until it is the exact problem
+    (:class:`~fixplan.planner.osculating_contact.OsculatingContact`); the motion is then its
+    multipliers. An exact contact with facets (point supports) is stated by its seed polytope,
+    which holds its exact set.
     """
 
     def __init__(self, contacts, models, forces, subspace):
@@ -279,21 +272,23 @@ class _ConicPrograms:
         ]
         self._direction = cp.Parameter(len(subspace), name="direction")
         self._loads = [cp.Variable(m.load_dimension) for m in models]
-        #: The exact contacts with friction: (index, model, normal force [N], their cuts).
+        #: The smooth exact contacts with friction: (index, model, normal force [N], ellipsoid).
         self._exact = [
-            (i, model, float(fn), ContactCuts(model, CUT_POOL))
+            (i, model, float(fn), OsculatingContact(model))
             for i, (model, fn) in enumerate(zip(models, forces, strict=True))
             if isinstance(model, Exact) and fn > 0.0 and not model.frictionless
-        ]
+            and not model.surface.has_facets
+        ]  # fmt: skip
         constraints, others, wrench = [], [], 0
-        exact = {i for i, *_ in self._exact}
+        exact = {i: ellipsoid for i, _, _, ellipsoid in self._exact}
         for i, (load, model, fn) in enumerate(zip(self._loads, models, forces, strict=True)):
+            if i in exact:
+                constraints.append(exact[i].constraint(load, float(fn)))
+                continue
             rows = model.constraints(load, float(fn))
             constraints += rows
-            if i not in exact:
-                others += rows
-                wrench = wrench + self._maps[i] @ load
-        constraints += [cuts.constraint(self._loads[i], fn) for i, _, fn, cuts in self._exact]
+            others += rows
+            wrench = wrench + self._maps[i] @ load
         self._others = wrench  # (the wrench of the contacts that are not exact; 0 if none)
         self._wrench = sum(m @ load for m, load in zip(self._maps, self._loads, strict=True))
         self._scale = cp.Variable(name="scale")
@@ -326,7 +321,9 @@ class _ConicPrograms:
         ``units``: the surface's axis extents, the scale at which the solver sees the load."""
         unit, size = unit_vector(wrench / units)  # (the gauge is homogeneous)
         self._direction.value = unit * units
-        for _ in range(MAX_CUT_ROUNDS):
+        for _, _, _, ellipsoid in self._exact:
+            ellipsoid.start()
+        for _ in range(MAX_OSCULATING_ROUNDS):
             try:
                 _solve(self._gauge)
             except FixplanError:
@@ -334,22 +331,18 @@ class _ConicPrograms:
                     return np.full(len(wrench), np.nan), float("inf")
                 raise
             twist = -np.asarray(self._balance.dual_value, dtype=float)
-            if not self._cut(twist):
+            moved = [
+                ellipsoid.follow(np.asarray(self._loads[i].value, dtype=float), fn,
+                                 self._maps[i].T @ twist)
+                for i, _, fn, ellipsoid in self._exact
+            ]  # fmt: skip
+            if not any(moved):
                 twist = twist if twist @ wrench >= 0.0 else -twist
                 return twist, float(self._scale.value) / size
         raise ConvergenceError(
-            f"contact-set surface: the loads of its exact contacts were still outside their "
-            f"exact sets after {MAX_CUT_ROUNDS} solves with tangent-plane cuts"
+            f"contact-set surface: the ellipsoids of its exact contacts did not settle on their "
+            f"exact sets in {MAX_OSCULATING_ROUNDS} solves"
         )
-
-    def _cut(self, motion: np.ndarray) -> bool:
-        """Cut off each exact contact's load outside its set (:meth:`ContactCuts.add`, about
-        its twist in the solve's impending ``motion``); whether any was."""
-        added = False
-        for i, _, fn, cuts in self._exact:
-            load = np.asarray(self._loads[i].value, dtype=float)
-            added |= cuts.add(load, fn, self._maps[i].T @ motion)
-        return added
 
 
 def _solve(problem: cp.Problem) -> None:

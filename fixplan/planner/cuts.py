@@ -36,7 +36,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-import cvxpy as cp
 import numpy as np
 
 from fixplan.planner.exact_contacts import ExactContacts
@@ -77,45 +76,6 @@ CUT_MARGIN = 1e-8
 
 #: A cut counts as active when its slack is below this fraction of the normal force.
 ACTIVE_RTOL = 1e-7
-
-
-class ContactCuts:
-    """Tangent-plane cuts of one exact contact's set in a small cvxpy program of its own (a
-    contact-set query, a compliant step): ``rows`` cut rows ``a · ℓ <= n`` in one Parameter
-    (DPP), the oldest replaced. Every cut holds the exact set, so a program keeps them across
-    solves with other data (but the same contact)."""
-
-    def __init__(self, model, rows: int):
-        self.model = model
-        self.parameter = cp.Parameter((rows, 3), value=np.zeros((rows, 3)))
-        self._next = 0
-
-    def constraint(self, load, bound) -> cp.Constraint:
-        """The cuts on the friction ``load`` (3 entries) at the normal force ``bound``."""
-        return self.parameter @ load <= bound
-
-    def add(self, load: np.ndarray, bound: float, motion: np.ndarray | None = None) -> bool:
-        """Cut off ``load`` ``(3,)`` [N, N, N m] where it lies outside the set at normal force
-        ``bound`` [N] by more than ``EXACT_CUT_RTOL``: the tangent plane at its sliding twist
-        and four tilted around the contact's twist in the program's impending ``motion``
-        (``DUAL_SPREAD``; where none, around that sliding twist, ``SPREAD``), all tightened by
-        ``CUT_MARGIN``. Returns whether it did."""
-        if not np.any(load) or bound <= 0.0:
-            return False
-        planes, excess = self.model.cut(load[None, :] / bound)
-        if excess[0] <= EXACT_CUT_RTOL:
-            return False
-        centre, spread = planes, SPREAD * np.sqrt(excess)
-        if motion is not None and np.any(motion):
-            centre = (motion if motion @ load >= 0.0 else -motion)[None, :]  # (outward)
-            spread = DUAL_SPREAD * np.sqrt(excess)
-        around = self.model.planes(around_twists(centre, self.model.rho, spread)[:, 0])
-        values = self.parameter.value.copy()
-        for row in (planes[0], *around):
-            values[self._next] = row * (1.0 + CUT_MARGIN)
-            self._next = (self._next + 1) % len(values)
-        self.parameter.value = values
-        return True
 
 
 class CutPool(ExactContacts):
@@ -192,7 +152,7 @@ class CutPool(ExactContacts):
                 moved = np.any(motion != 0.0, axis=1)
                 centres = np.where(moved[:, None], motion, centres)
                 spread = np.where(moved, DUAL_SPREAD * root, spread)
-            around = model.planes(around_twists(centres, model.rho, spread).reshape(-1, 3))
+            around = model.planes(_around(centres, model.rho, spread).reshape(-1, 3))
             new = [planes, *around.reshape(4, -1, 3)]
             order = _slots(self._used[:, e, cases], slack[:, e, cases] / forces[e, cases])
             for rows, slots in zip(new, order[: len(new)], strict=True):
@@ -222,7 +182,7 @@ def _slots(used: np.ndarray, slack: np.ndarray) -> np.ndarray:
     return np.lexsort((-slack, used), axis=0)
 
 
-def around_twists(twists: np.ndarray, rho: float, spread: np.ndarray) -> np.ndarray:
+def _around(twists: np.ndarray, rho: float, spread: np.ndarray) -> np.ndarray:
     """Four twists ``(4, K, 3)`` around each twist of ``twists`` ``(K, 3)``, tilted by ``±spread``
     along two directions normal to it in normalised coordinates ``(vx, vy, rho w)``."""
     scale = np.array([1.0, 1.0, rho])
