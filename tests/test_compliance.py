@@ -298,18 +298,20 @@ def test_with_normal_forces_fixed_by_statics_the_part_moves_at_the_rigid_safety_
     assert result.held["mill"] == (rigid >= 1.0)
 
 
-def _random_fixture(rng):
+def _random_fixture(rng, contact=_point):
     """A box on three supports against two side locators and an end locator, each set pressed
-    by its own clamp, under a random load."""
+    by its own clamp, under a random load (``contact`` makes the contacts, as :func:`_point`)."""
     size = np.array([0.2, 0.12, 0.05])
     contacts = []
     for i in range(3):
         xy = rng.uniform(0.1, 0.9, 2) * size[:2]
-        contacts.append(_point(f"z{i}", "support", [*xy, 0.0], [0, 0, 1], mu=rng.uniform(0.2, 0.6)))
+        contacts.append(
+            contact(f"z{i}", "support", [*xy, 0.0], [0, 0, 1], mu=rng.uniform(0.2, 0.6))
+        )
     for i, x in enumerate(np.array([0.2, 0.8]) * size[0]):
         z = rng.uniform(0.3, 0.7) * size[2]
-        contacts.append(_point(f"y{i}", "locator", [x, 0.0, z], [0, 1, 0], mu=0.3))
-    contacts.append(_point("x0", "locator", [0.0, size[1] / 2, size[2] / 2], [1, 0, 0], mu=0.3))
+        contacts.append(contact(f"y{i}", "locator", [x, 0.0, z], [0, 1, 0], mu=0.3))
+    contacts.append(contact("x0", "locator", [0.0, size[1] / 2, size[2] / 2], [1, 0, 0], mu=0.3))
     clamps = [
         ("top", [*(rng.uniform(0.3, 0.7, 2) * size[:2]), size[2]], [0, 0, -1]),
         ("side", [size[0] / 2, size[1], size[2] / 2], [0, -1, 0]),
@@ -317,7 +319,7 @@ def _random_fixture(rng):
     ]
     for name, position, normal in clamps:
         force = rng.uniform(50.0, 200.0)
-        contacts.append(_point(name, "clamp", position, normal, mu=0.3, force=force))
+        contacts.append(contact(name, "clamp", position, normal, mu=0.3, force=force))
     load = Load(name="cut", force=rng.normal(size=3) * 20.0, point=rng.uniform(0, 1, 3) * size)
     problem = _problem(contacts, [load], mass=2.0, centre=size / 2, gravity=(0, 0, -9.81))
     stiffness = {
@@ -327,10 +329,10 @@ def _random_fixture(rng):
     return problem, stiffness
 
 
-def _random_case(seed):
+def _random_case(seed, contact=_point):
     from fixplan.planner.planner import Planner
 
-    problem, stiffness = _random_fixture(np.random.default_rng(seed))
+    problem, stiffness = _random_fixture(np.random.default_rng(seed), contact)
     result = analyse(problem, None, stiffness=stiffness)
     rigid = Planner(problem, allow_squeeze=True).solve().safety_factors["cut"]
     return result.first_slip["cut"], result.collapse["cut"], rigid
@@ -462,3 +464,20 @@ def test_exact_models_with_facets_warn_that_the_steps_state_their_seed_polytopes
     problem = dataclasses.replace(problem, contacts=tuple(contacts))
     with pytest.warns(UserWarning, match=r"s1, s2, s3 have facets .* seed polytopes"):
         analyse(problem, None, stiffness=Stiffness(normal=1e7, tangential=3e6, torsional=20.0))
+
+
+def _exact_pads(name, role, position, normal, *, mu=0.5, force=None):
+    """:func:`_point`, but clamps and supports on exact disk pads."""
+    if role not in ("clamp", "support"):
+        return _point(name, role, position, normal, mu=mu, force=force)
+    return Contact(name=name, role=role, position=position, normal=normal, mu=mu, model="exact",
+                   patch=pressure.disk(0.006), force=force)  # fmt: skip
+
+
+# The seeds whose collapse exceeded the rigid exact safety factor (by up to 8.1 %) when exact
+# models were stated by their seed polytopes; now none of the first 30 does (one not found).
+@pytest.mark.parametrize("seed", [10, 11, 15, 27])
+def test_with_exact_pads_the_collapse_lies_between_first_slip_and_rigid_safety_factor(seed):
+    first, collapse, rigid = _random_case(seed, _exact_pads)
+    assert first <= collapse * (1 + 1e-9)
+    assert collapse <= rigid * (1 + 1e-6)
