@@ -307,7 +307,8 @@ class _ConicPrograms:
         if self._support is not None:
             self._direction.value = unit
             _solve(self._support)
-            value, wrench = float(self._support.value), np.asarray(self._others.value, float)
+            value = max(float(self._support.value), 0.0)  # (every set holds 0: noise below it)
+            wrench = np.asarray(self._others.value, float)
         for i, model, fn, _ in self._exact:
             contact_twist = self._maps[i].T @ unit
             if np.any(contact_twist):
@@ -338,7 +339,7 @@ class _ConicPrograms:
             ]  # fmt: skip
             if not any(moved):
                 twist = twist if twist @ wrench >= 0.0 else -twist
-                return twist, float(self._scale.value) / size
+                return twist, max(float(self._scale.value), 0.0) / size  # (as the support)
         raise ConvergenceError(
             f"contact-set surface: the ellipsoids of its exact contacts did not settle on their "
             f"exact sets in {MAX_OSCULATING_ROUNDS} solves"
