@@ -167,7 +167,9 @@ class ContactSetSurface:
     def load(self, twist) -> np.ndarray:
         """A wrench on the surface that sustains sliding with ``twist`` (a support point)."""
         direction = _vector("twist", twist, len(self.subspace))
-        if self._exact is not None and np.any(direction):
+        if not np.any(direction):
+            return np.zeros(len(self.subspace))
+        if self._exact is not None:
             return self._exact.load(direction)
         return self._conic.support(direction)[1]
 
@@ -255,7 +257,7 @@ class _ConicPrograms:
     queried with DPP problems compiled once (Clarabel).
 
     The support function of the sum is the sum of the contacts' supports: the exact contacts'
-    from their exact surfaces, the others' from one conic solve. The gauge of a direction (its
+    from their exact surfaces (facets included), the others' from one conic solve. The gauge of a direction (its
     safety factor) is one conic problem over all contacts, each smooth exact contact stated by
     the ellipsoid that osculates its exact set where its load meets it, solved again with the
     ellipsoids moved until it is the exact problem
@@ -272,23 +274,28 @@ class _ConicPrograms:
         ]
         self._direction = cp.Parameter(len(subspace), name="direction")
         self._loads = [cp.Variable(m.load_dimension) for m in models]
-        #: The smooth exact contacts with friction: (index, model, normal force [N], ellipsoid).
-        self._exact = [
-            (i, model, float(fn), OsculatingContact(model))
+        #: The exact contacts with friction, by index: (model, normal force [N]).
+        self._exact = {
+            i: (model, float(fn))
             for i, (model, fn) in enumerate(zip(models, forces, strict=True))
             if isinstance(model, Exact) and fn > 0.0 and not model.frictionless
-            and not model.surface.has_facets
-        ]  # fmt: skip
+        }
+        #: Their ellipsoids in the gauge, but for those with facets (their seed polytopes).
+        self._ellipsoids = {
+            i: OsculatingContact(model)
+            for i, (model, _) in self._exact.items()
+            if not model.surface.has_facets
+        }
         constraints, others, wrench = [], [], 0
-        exact = {i: ellipsoid for i, _, _, ellipsoid in self._exact}
         for i, (load, model, fn) in enumerate(zip(self._loads, models, forces, strict=True)):
-            if i in exact:
-                constraints.append(exact[i].constraint(load, float(fn)))
+            if i in self._ellipsoids:
+                constraints.append(self._ellipsoids[i].constraint(load, float(fn)))
                 continue
             rows = model.constraints(load, float(fn))
             constraints += rows
-            others += rows
-            wrench = wrench + self._maps[i] @ load
+            if i not in self._exact:
+                others += rows
+                wrench = wrench + self._maps[i] @ load
         self._others = wrench  # (the wrench of the contacts that are not exact; 0 if none)
         self._wrench = sum(m @ load for m, load in zip(self._maps, self._loads, strict=True))
         self._scale = cp.Variable(name="scale")
@@ -309,7 +316,7 @@ class _ConicPrograms:
             _solve(self._support)
             value = max(float(self._support.value), 0.0)  # (every set holds 0: noise below it)
             wrench = np.asarray(self._others.value, float)
-        for i, model, fn, _ in self._exact:
+        for i, (model, fn) in self._exact.items():
             contact_twist = self._maps[i].T @ unit
             if np.any(contact_twist):
                 scale = fn / model.surface.normal_force
@@ -322,7 +329,7 @@ class _ConicPrograms:
         ``units``: the surface's axis extents, the scale at which the solver sees the load."""
         unit, size = unit_vector(wrench / units)  # (the gauge is homogeneous)
         self._direction.value = unit * units
-        for _, _, _, ellipsoid in self._exact:
+        for ellipsoid in self._ellipsoids.values():
             ellipsoid.start()
         for _ in range(MAX_OSCULATING_ROUNDS):
             try:
@@ -333,9 +340,9 @@ class _ConicPrograms:
                 raise
             twist = -np.asarray(self._balance.dual_value, dtype=float)
             moved = [
-                ellipsoid.follow(np.asarray(self._loads[i].value, dtype=float), fn,
-                                 self._maps[i].T @ twist)
-                for i, _, fn, ellipsoid in self._exact
+                ellipsoid.follow(np.asarray(self._loads[i].value, dtype=float),
+                                 self._exact[i][1], self._maps[i].T @ twist)
+                for i, ellipsoid in self._ellipsoids.items()
             ]  # fmt: skip
             if not any(moved):
                 twist = twist if twist @ wrench >= 0.0 else -twist
