@@ -55,15 +55,15 @@ def test_exact_fingers_off_the_plane_are_cut_to_their_exact_sets():
                                    rtol=1e-13, atol=1e-15)  # fmt: skip
 
 
-def test_exact_contacts_beside_an_ellipsoid_obey_the_laws_of_a_minkowski_sum():
-    """An exact clamp from above, an ellipsoid pad and a pin: the support of the set is the sum
+def test_exact_contacts_beside_a_cone_obey_the_laws_of_a_minkowski_sum():
+    """An exact clamp from above, a cone-model pad and a pin: the support of the set is the sum
     of each contact's alone, and at a safety factor's load ``s d`` its motion ``V`` is the
     normal there: ``h(V) = s d·V`` (to 1e-7, the solver's accuracy)."""
     contacts = [
         Contact(name="clamp", role="clamp", position=[0.0, 0.01, 0.02], normal=[0, 0, -1],
                 mu=0.4, model="exact", patch=pressure.rectangle(0.03, 0.01).shifted(0.004, 0)),
         Contact(name="pad", role="support", position=[0.02, -0.01, 0.0], normal=[0, 0, 1],
-                mu=0.5, model="ellipsoid", patch=pressure.disk(0.012)),
+                mu=0.5, model="cone", patch=pressure.disk(0.012)),
         Contact(name="pin", role="support", position=[-0.03, 0.0, 0.0], normal=[0, 0, 1],
                 mu=0.3, model="point-cone"),
     ]  # fmt: skip

@@ -10,6 +10,7 @@ import pytest
 
 from fixplan import Contact, ContactSetSurface, LimitSurface, pressure
 from fixplan.errors import InvalidArgumentError
+from fixplan.models import Ellipsoid
 from fixplan.motion import slide
 from fixplan.surface.geometry import Pose, signed_area
 from fixplan.surface.kernels import twist_to_local
@@ -163,7 +164,7 @@ def test_a_set_of_points_and_exact_patches_is_their_exact_surface():
 @pytest.mark.parametrize(
     ("change", "forces"),
     [
-        ({"top": {"model": "ellipsoid"}}, [3.0, 2.0, 4.0, 5.0]),  # (an approximate model)
+        ({"top": {"model": "cone"}}, [3.0, 2.0, 4.0, 5.0]),  # (a cone: not smooth)
         ({"top": {"normal": [0.0, 0.1, -1.0]}}, [3.0, 2.0, 4.0, 5.0]),  # (not on the plane)
         ({}, [0.0, 2.0, 0.0, 5.0]),  # (one point alone: no torsional friction)
     ],
@@ -208,3 +209,72 @@ def test_a_part_turning_about_a_pin_beside_a_pad_stops_as_the_closed_form_says()
     angle = moved.poses[-1, 2]
     turn = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
     np.testing.assert_allclose(moved.poses[-1, :2] + turn @ pin, pin, rtol=0, atol=1e-12)
+
+
+def test_an_ellipsoid_surface_is_its_model_in_closed_form():
+    """The surface of an Ellipsoid model's set (tilted: the pad's pressure is off its frame's
+    origin) at 5 N: supports ``N sqrt(V^T A^-1 V)`` to 1e-14, safety factors the model's to
+    1e-13, motions along the ellipsoid's normal ``A L`` (1e-10 rad in normalised coordinates,
+    the inverse map's accuracy) and the Hessian the derivative of the load (central differences,
+    1e-6)."""
+    model = Ellipsoid.from_limit_surface(LimitSurface(PAD, mu=0.4, normal_force=1.0))
+    matrix = model.load_matrix
+    surface = LimitSurface.ellipsoid(matrix, normal_force=5.0)
+    inverse = np.linalg.inv(matrix)
+    twists = RNG.normal(size=(20, 3)) * [1.0, 1.0, 30.0]
+    closed = 5.0 * np.sqrt(np.einsum("ki,ij,kj->k", twists, inverse, twists))
+    np.testing.assert_allclose(surface.support(twists), closed, rtol=1e-14)
+    loads = RNG.normal(size=(20, 3)) * [1.0, 1.0, 0.02]
+    expected = [model.safety_factor(load, normal_force=5.0) for load in loads]
+    np.testing.assert_allclose(surface.safety_factor(loads), expected, rtol=1e-13)
+    units = surface.max_force * np.array([1.0, 1.0, surface.characteristic_length])
+    motions, normals = surface.motion(loads) * units, loads @ matrix * units  # (normalised)
+    sines = np.linalg.norm(np.cross(motions, normals), axis=1)
+    assert np.all(
+        sines <= 1e-10 * np.linalg.norm(motions, axis=1) * np.linalg.norm(normals, axis=1)
+    )
+    twist, step = twists[0], 1e-6 * np.linalg.norm(twists[0])
+    numeric = np.column_stack([
+        (surface.load(twist + step * e) - surface.load(twist - step * e)) / (2 * step)
+        for e in np.eye(3)
+    ])  # fmt: skip
+    np.testing.assert_allclose(surface.support_hessian(twist), numeric, rtol=1e-6, atol=1e-9)
+    assert "ellipsoid" in repr(surface)
+
+
+@pytest.mark.parametrize(
+    ("matrix", "message"),
+    [
+        (np.diag([1.0, 1.0, np.nan]), "finite"),
+        (np.array([[1.0, 0.5, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]), "symmetric"),
+        (np.diag([1.0, -1.0, 1.0]), "positive definite"),
+    ],
+)
+def test_an_ellipsoid_surface_refuses_a_matrix_that_is_no_ellipsoid(matrix, message):
+    with pytest.raises(InvalidArgumentError, match=message):
+        LimitSurface.ellipsoid(matrix, normal_force=1.0)
+
+
+def test_a_part_turning_about_a_pin_beside_an_ellipsoid_pad_stops_as_the_closed_form_says():
+    """As beside an exact pad (above), with the pad's Ellipsoid model: its friction moment about
+    the pin is ``N sqrt(u^T A^-1 u)`` at the pad's own twist ``u`` of the unit rotation about the
+    pin."""
+    pin, pad_at = np.array([-0.03, 0.0]), np.array([0.02, 0.01])
+    contacts = [
+        Contact(name="pin", role="support", position=[*pin, 0.0], normal=[0, 0, 1], mu=0.5,
+                model="point-cone"),
+        Contact(name="pad", role="support", position=[*pad_at, 0.0], normal=[0, 0, 1],
+                mu=0.4, model="ellipsoid", patch=PAD),
+    ]  # fmt: skip
+    surface = ContactSetSurface(contacts, [20.0, 0.5])
+    assert surface.as_limit_surface() is not None
+    mass, inertia, spin = 1.0, 1e-3, 3.0
+    about_pin = np.array([pin[1], -pin[0], 1.0])
+    moved = slide(surface, mass=mass, inertia=inertia, twist0=spin * about_pin, duration=1.0)
+    own = np.array([about_pin[0] - pad_at[1], about_pin[1] + pad_at[0], 1.0])  # (at the pad)
+    matrix = Ellipsoid.from_limit_surface(LimitSurface(PAD, mu=0.4, normal_force=1.0)).load_matrix
+    moment = 0.5 * np.sqrt(own @ np.linalg.solve(matrix, own))
+    turning_inertia = inertia + mass * pin @ pin
+    assert [index for _, _, index in moved.pivots] == [0]
+    assert moved.poses[-1, 2] == pytest.approx(spin**2 * turning_inertia / (2 * moment),
+                                               rel=1e-12)  # fmt: skip

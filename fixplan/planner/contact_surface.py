@@ -8,8 +8,8 @@ the limit surface of the whole fixture in that subspace. Wrench components are a
 origin: ``fx, fy, fz`` [N], ``mx, my, mz`` [N m]; twists pair with them as
 ``(vx, vy, vz, wx, wy, wz)``.
 
-Point contacts and exact patches on a plane (subspace ``("fx", "fy", "mz")``, normals along
-``±z``) make up an exact :class:`~fixplan.LimitSurface`: the patches' surfaces placed in the
+Point contacts and exact or ellipsoid patches on a plane (subspace ``("fx", "fy", "mz")``,
+normals along ``±z``) make up a :class:`~fixplan.LimitSurface`: the patches' sets placed in the
 part's frame (mirrored for a contact from above) and summed with the points'
 (:meth:`ContactSetSurface.as_limit_surface`), which the queries then ask. Other sets are written
 with each contact's friction model as cvxpy constraints and queried with DPP problems compiled
@@ -27,7 +27,7 @@ import cvxpy as cp
 import numpy as np
 
 from fixplan.errors import ConvergenceError, FixplanError, InvalidArgumentError
-from fixplan.models import Exact, PointCone
+from fixplan.models import Ellipsoid, Exact, FittedEllipsoid, PointCone
 from fixplan.planner.contact_models import contact_models
 from fixplan.planner.osculating_contact import MAX_OSCULATING_ROUNDS, OsculatingContact
 from fixplan.planner.problem import Contact
@@ -102,11 +102,12 @@ class ContactSetSurface:
     def as_limit_surface(self) -> LimitSurface | None:
         """The same surface as an exact :class:`~fixplan.LimitSurface`, where it is one: the
         subspace :data:`PLANAR`, and every contact that takes friction with its normal along
-        ``±z`` and either a :class:`~fixplan.models.PointCone` (its friction the disk of ``mu``
-        times its normal force, at its ``(x, y)``) or an :class:`~fixplan.models.Exact` model
-        (its patch's exact surface at its normal force, placed in the plane by its frame:
-        mirrored where the normal is ``-z``); a patch, or point contacts in two or more places.
-        ``None`` otherwise. Where it exists, the queries of this class ask it (exact, and no
+        ``±z`` and a :class:`~fixplan.models.PointCone` (its friction the disk of ``mu`` times
+        its normal force, at its ``(x, y)``), an :class:`~fixplan.models.Exact` model (its
+        patch's exact surface at its normal force) or an :class:`~fixplan.models.Ellipsoid` or
+        :class:`~fixplan.models.FittedEllipsoid` (its ellipsoid, :meth:`LimitSurface.ellipsoid`),
+        a patch's placed in the plane by its frame (mirrored where the normal is ``-z``); a
+        patch, or point contacts in two or more places. ``None`` otherwise. Where it exists, the queries of this class ask it (exact, and no
         conic solve per call), and so do the sliding dynamics and pushing trajectories, which
         follow a part turning about one of its points as such (the conic programs' friction at
         a point at rest is any of its disk). Its point supports are the point contacts' with
@@ -132,6 +133,9 @@ class ContactSetSurface:
                 points_force += float(force)
             elif isinstance(model, Exact):
                 patches.append((model.surface, _plane_pose(contact), float(force)))
+            elif isinstance(model, Ellipsoid | FittedEllipsoid):
+                ellipsoid = LimitSurface.ellipsoid(model.load_matrix, normal_force=float(force))
+                patches.append((ellipsoid, _plane_pose(contact), float(force)))
             else:
                 return None
         try:

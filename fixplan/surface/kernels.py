@@ -172,3 +172,30 @@ class SumKernel(SupportKernel):
 
     def smoothed(self, smoothing):
         return SumKernel(tuple(p.smoothed(smoothing) for p in self.parts), self.scales)
+
+
+@dataclass(frozen=True, slots=True)
+class EllipsoidKernel(SupportKernel):
+    """The support function of an ellipsoid ``L^T A L <= 1`` (a friction model's set rather than
+    a patch's): ``h(V) = sqrt(V^T B V)`` with ``B = A^{-1}`` (``inverse``), its load
+    ``B V / h(V)`` and Hessian ``(B - B V V^T B / h²) / h`` in closed form."""
+
+    inverse: np.ndarray
+
+    @property
+    def size(self) -> float:
+        # (The largest moment over the largest force: the lever of the surface's twists.)
+        return float(np.sqrt(self.inverse[2, 2] / self.inverse[0, 0]))
+
+    def evaluate(self, twists):
+        stretched = twists @ self.inverse
+        h = np.sqrt(np.einsum("kc,kc->k", twists, stretched))
+        return h, stretched / h[:, None]
+
+    def hessian(self, twists):
+        return self.newton_terms(twists)[2]
+
+    def newton_terms(self, twists):
+        h, loads = self.evaluate(twists)
+        hess = (self.inverse[None] - loads[:, :, None] * loads[:, None, :]) / h[:, None, None]
+        return h, loads, hess

@@ -46,7 +46,7 @@ from fixplan.surface.disk_kernel import AnnulusKernel, DiskKernel
 from fixplan.surface.geometry import Pose, triangulate
 from fixplan.surface.grid_kernel import block_rule, grid_nodes
 from fixplan.surface.inverse import solve
-from fixplan.surface.kernels import PosedKernel, SumKernel, SupportKernel
+from fixplan.surface.kernels import EllipsoidKernel, PosedKernel, SumKernel, SupportKernel
 from fixplan.surface.point_kernel import PointSetKernel
 from fixplan.surface.polygon_kernel import polygon_edges
 from fixplan.surface.pressure import (
@@ -181,6 +181,28 @@ class LimitSurface:
         combined._setup(kernel, 1.0, shape)
         return combined
 
+    @classmethod
+    def ellipsoid(cls, load_matrix, *, normal_force: float) -> LimitSurface:
+        """The surface of the ellipsoid ``L^T A L <= N²`` with ``A`` the ``load_matrix`` (per
+        unit normal force, as :attr:`~fixplan.models.Ellipsoid.load_matrix` gives it) at the
+        ``normal_force`` ``N`` [N]: a friction model's set as a surface, to be placed and
+        summed with patches and point supports (:meth:`placed`, :meth:`combine`). Its support
+        ``N sqrt(V^T A^{-1} V)``, load and Hessian are closed forms; its ``field`` and ``mu``
+        are ``None``."""
+        matrix = validation.finite_array("load_matrix", load_matrix, shape=(3, 3))
+        if not np.allclose(matrix, matrix.T, rtol=1e-12, atol=0.0):
+            raise InvalidArgumentError("load_matrix must be symmetric")
+        try:
+            inverse = np.linalg.inv(np.linalg.cholesky(matrix))  # (refuses all but SPD)
+        except np.linalg.LinAlgError:
+            raise InvalidArgumentError("load_matrix must be positive definite") from None
+        force = validation.positive_scalar("normal_force", normal_force)
+        _check_forces(force, force * float(np.sqrt((inverse.T @ inverse)[0, 0])))
+        surface = cls.__new__(cls)
+        surface.field, surface._mu, surface._normal_force, surface._parts = None, None, force, ()
+        surface._setup(EllipsoidKernel(inverse.T @ inverse), force)
+        return surface
+
     def placed(self, pose: Pose, *, normal_force: float | None = None) -> LimitSurface:
         """This surface with its frame placed by ``pose`` in another frame (a contact's surface
         in the plane of the part it holds; the pose is mirrored where the contact faces the
@@ -253,6 +275,7 @@ class LimitSurface:
             what = f"{len(self._parts)} parts"
         else:
             what = "placed" if self.field is None else type(self.field).__name__
+            what = "ellipsoid" if isinstance(self._kernel, EllipsoidKernel) else what
         return (
             f"LimitSurface({what}, max_force={self.max_force:.6g} N, "
             f"max_moment={self.max_moment:.6g} N m)"
