@@ -72,7 +72,7 @@ def forward_map(surface) -> ForwardMap:
 def exact_form(surface):
     """``surface``, or the exact :class:`~fixplan.LimitSurface` it equals where it is another
     kind that has one: the :class:`~fixplan.models.Exact` model's, or a
-    :class:`~fixplan.ContactSetSurface` of point contacts and exact patches on a plane
+    :class:`~fixplan.ContactSetSurface` of point contacts and exact or ellipsoid patches on a plane
     (:meth:`~fixplan.ContactSetSurface.as_limit_surface`)."""
     if isinstance(surface, Exact):
         return surface.surface

@@ -296,9 +296,9 @@ def _integrate(rate, span, state, samples, events, atol):
         f"slide: the motion from t = {span[0]:.6g} s took more than {MAX_EVALUATIONS:,} "
         "evaluations of its equations, or failed, with RK45 and with LSODA: its friction "
         "switches faster than either can follow (as at a point contact of a "
-        "ContactSetSurface with patches of an approximate model too, whose turns about its "
-        "points are not followed; a LimitSurface's point supports are, and a set of point "
-        "contacts and exact patches is one). Support the part on a patch, or shorten the "
+        "ContactSetSurface with cone or pyramid patches too, whose turns about its points are "
+        "not followed; a LimitSurface's point supports are, and a set of point contacts and "
+        "exact or ellipsoid patches is one). Support the part on a patch, or shorten the "
         "duration"
     )
 

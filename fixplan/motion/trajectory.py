@@ -138,7 +138,7 @@ def push(
     """
     if not isinstance(shape, Outline):
         raise InvalidArgumentError(f"shape must be an Outline, got {type(shape).__name__}")
-    surface = exact_form(surface)  # (a set of point contacts and exact patches: exact maps)
+    surface = exact_form(surface)  # (points and exact or ellipsoid patches: a LimitSurface)
     if isinstance(pusher, PointPusher):
         contact = _RoundContact(surface, shape, pusher)
     elif isinstance(pusher, LinePusher):
