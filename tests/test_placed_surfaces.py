@@ -278,3 +278,30 @@ def test_a_part_turning_about_a_pin_beside_an_ellipsoid_pad_stops_as_the_closed_
     assert [index for _, _, index in moved.pivots] == [0]
     assert moved.poses[-1, 2] == pytest.approx(spin**2 * turning_inertia / (2 * moment),
                                                rel=1e-12)  # fmt: skip
+
+
+def test_a_placed_tactile_grid_and_a_placed_sum_are_their_parts_built_in_the_other_frame():
+    """A tactile grid placed by a mirrored pose is the grid with its rows flipped, turned and
+    shifted as a field (1e-13; it stays compiled); a combined surface placed is the sum of its
+    parts placed, its point supports moved with them."""
+    rng = np.random.default_rng(3)
+    x, y = np.linspace(-0.01, 0.01, 9), np.linspace(-0.006, 0.006, 7)
+    values = rng.uniform(0.0, 1.0, (7, 9))
+    pose = Pose(angle=0.8, offset=(0.05, -0.02), mirrored=True)
+    grid = LimitSurface(pressure.grid(x, y, values, centered=False), mu=0.3, normal_force=2.0)
+    placed = grid.placed(pose, normal_force=3.0)
+    flipped = pressure.grid(x, -y[::-1], values[::-1], centered=False).rotated(0.8)
+    direct = LimitSurface(flipped.shifted(0.05, -0.02), mu=0.3, normal_force=3.0)
+    twists = rng.normal(size=(30, 3)) * [1.0, 1.0, 50.0]
+    np.testing.assert_allclose(placed.support(twists), direct.support(twists), rtol=1e-13)
+    loads = rng.normal(size=(30, 3)) * [1.0, 1.0, 0.01]
+    np.testing.assert_allclose(placed.safety_factor(loads), direct.safety_factor(loads),
+                               rtol=1e-13)  # fmt: skip
+    assert placed._compiled is not None
+    disk = LimitSurface(pressure.disk(0.01).shifted(0.01, 0.0), mu=0.4, normal_force=1.0)
+    points = LimitSurface(pressure.points([[0.0, 0.02], [0.01, -0.02]]), mu=0.2, normal_force=2.0)
+    summed = LimitSurface.combine([disk, points]).placed(pose)
+    parts = disk.placed(pose).support(twists) + points.placed(pose).support(twists)
+    np.testing.assert_allclose(summed.support(twists), parts, rtol=1e-14)
+    np.testing.assert_allclose(summed.point_supports[0], pose.apply(points.point_supports[0]),
+                               rtol=0, atol=1e-17)  # fmt: skip
