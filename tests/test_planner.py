@@ -429,6 +429,31 @@ def test_contact_set_surface_of_a_plan_holds_what_the_plan_says_is_at_the_limit(
     assert surface.safety_factor(scaled) == pytest.approx(1.0, rel=1e-6)
 
 
+@pytest.mark.parametrize("pad", ["exact", "ellipsoid"])
+def test_the_contact_set_of_a_plan_with_exact_pads_holds_its_impending_slip_on_its_surface(pad):
+    """Two rectangular pads (turned, off their frames' origins; one exact, the other exact or an
+    ellipsoid) and a pin: the plan's impending slip lies on the set's exact form to 1e-7 (7e-9
+    and 3e-9 measured). With each exact pad its seed polytope, as before, the set held it with a
+    safety factor of 1.041 and 1.029."""
+    patch = pressure.rectangle(0.02, 0.01).shifted(0.002, 0.0)
+    places = [([0.03, 0.0], pad), ([-0.02, 0.025], "exact"), ([-0.02, -0.03], "point-cone")]
+    contacts = [
+        Contact(name=f"p{k}", role="support", position=[x, y, 0], normal=[0, 0, 1], mu=MU,
+                model=model, patch=None if model == "point-cone" else patch,
+                axis=[np.cos(0.3), np.sin(0.3), 0.0])
+        for k, ((x, y), model) in enumerate(places)
+    ]  # fmt: skip
+    problem = Problem(
+        body=Body(mass=2.0, center_of_mass=[0.0, 0.0, 0.05]), contacts=contacts, loads=[PUSH],
+        objective="max-safety-factor",
+    )  # fmt: skip
+    plan = solve(problem)
+    surface = ContactSetSurface.from_plan(problem, plan, "push")
+    assert surface.as_limit_surface() is not None
+    scaled = plan.safety_factors["push"] * planar_load(PUSH)
+    assert surface.safety_factor(scaled) == pytest.approx(1.0, rel=1e-7)
+
+
 def test_a_load_that_nothing_can_balance_has_safety_factor_zero():
     # Fixed fingers push along y; a load along the grasp axis cannot be balanced at any scale
     # above zero (only the fixed squeeze acts along it).
