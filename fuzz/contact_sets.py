@@ -12,11 +12,10 @@ largest residual. The README's figures on fuzzed contact sets are from
 
 from __future__ import annotations
 
-import argparse
 import collections
-import warnings
 
 import numpy as np
+from seeds import seeds, summary
 
 from fixplan import Contact, ContactSetSurface, pressure
 from fixplan.errors import FixplanError
@@ -71,26 +70,19 @@ def _residual(seed: int) -> float:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("seeds", nargs="+", help="ranges of seeds, FIRST:STOP")
-    args = parser.parse_args()
-    warnings.simplefilter("ignore")
     outcomes, worst = collections.Counter(), 0.0
-    for text in args.seeds:
-        first, stop = (int(v) for v in text.split(":"))
-        for seed in range(first, stop):
-            try:
-                residual = _residual(seed)
-            except (FixplanError, AssertionError) as exc:
-                outcomes[type(exc).__name__] += 1
-                print(f"seed {seed}: {type(exc).__name__}: {str(exc)[:150]}", flush=True)
-                continue
-            worst = max(worst, residual)
-            outcomes["ok" if residual < 1e-6 else "off the law"] += 1
-            if residual >= 1e-6:
-                print(f"seed {seed}: normality missed by {residual:.3g}", flush=True)
-    summary = ", ".join(f"{count} {name}" for name, count in sorted(outcomes.items()))
-    print(f"{summary}; largest residual {worst:.3g}")
+    for seed in seeds(__doc__.splitlines()[0]):
+        try:
+            residual = _residual(seed)
+        except (FixplanError, AssertionError) as exc:
+            outcomes[type(exc).__name__] += 1
+            print(f"seed {seed}: {type(exc).__name__}: {str(exc)[:150]}", flush=True)
+            continue
+        worst = max(worst, residual)
+        outcomes["ok" if residual < 1e-6 else "off the law"] += 1
+        if residual >= 1e-6:
+            print(f"seed {seed}: normality missed by {residual:.3g}", flush=True)
+    print(f"{summary(outcomes)}; largest residual {worst:.3g}")
 
 
 if __name__ == "__main__":

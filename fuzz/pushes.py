@@ -12,12 +12,11 @@ polygon the surface refuses is skipped).
 
 from __future__ import annotations
 
-import argparse
 import collections
 import time
-import warnings
 
 import numpy as np
+from seeds import seeds, summary
 
 from fixplan import LimitSurface, pressure
 from fixplan.errors import FixplanError, GeometryError
@@ -82,27 +81,20 @@ def _run(seed: int) -> tuple[str, float] | None:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("seeds", nargs="+", help="ranges of seeds, FIRST:STOP")
-    args = parser.parse_args()
-    warnings.simplefilter("ignore")
     outcomes, deepest = collections.Counter(), 0.0
-    for text in args.seeds:
-        first, stop = (int(v) for v in text.split(":"))
-        for seed in range(first, stop):
-            began = time.perf_counter()
-            found = _run(seed)
-            if found is None:
-                continue
-            outcome, overlap = found
-            deepest = min(deepest, overlap)
-            took = time.perf_counter() - began
-            outcomes["failed" if outcome != "ok" and not outcome.startswith("refused") else
-                     outcome.split(":")[0]] += 1  # fmt: skip
-            if outcome != "ok" or took > 10:
-                print(f"seed {seed} ({took:.1f} s): {outcome}", flush=True)
-    summary = ", ".join(f"{count} {name}" for name, count in sorted(outcomes.items()))
-    print(f"{summary}; deepest overlap {0.0 - deepest:.3g} of the part's size")
+    for seed in seeds(__doc__.splitlines()[0]):
+        began = time.perf_counter()
+        found = _run(seed)
+        if found is None:
+            continue
+        outcome, overlap = found
+        deepest = min(deepest, overlap)
+        took = time.perf_counter() - began
+        outcomes["failed" if outcome != "ok" and not outcome.startswith("refused") else
+                 outcome.split(":")[0]] += 1  # fmt: skip
+        if outcome != "ok" or took > 10:
+            print(f"seed {seed} ({took:.1f} s): {outcome}", flush=True)
+    print(f"{summary(outcomes)}; deepest overlap {0.0 - deepest:.3g} of the part's size")
 
 
 if __name__ == "__main__":

@@ -9,13 +9,12 @@ whose points are fewer than two distinct ones are skipped, as the surface refuse
 
 from __future__ import annotations
 
-import argparse
 import collections
 import signal
 import time
-import warnings
 
 import numpy as np
+from seeds import seeds, summary
 
 from fixplan import LimitSurface, pressure
 from fixplan.errors import FixplanError
@@ -81,30 +80,24 @@ def _time_up(*_) -> None:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("seeds", nargs="+", help="ranges of seeds, FIRST:STOP")
-    args = parser.parse_args()
-    warnings.simplefilter("ignore")
     signal.signal(signal.SIGALRM, _time_up)
     outcomes = collections.Counter()
-    for text in args.seeds:
-        first, stop = (int(v) for v in text.split(":"))
-        for seed in range(first, stop):
-            began = time.perf_counter()
-            signal.alarm(TIME_LIMIT)
-            try:
-                outcome = _run(seed)
-            except TimeoutError:
-                outcome = f"stopped after {TIME_LIMIT} s"
-            finally:
-                signal.alarm(0)
-            if outcome is None:
-                continue
-            took = time.perf_counter() - began
-            outcomes["ok" if outcome == "ok" else "failed"] += 1
-            if outcome != "ok" or took > 10:
-                print(f"seed {seed} ({took:.1f} s): {outcome}", flush=True)
-    print(", ".join(f"{count} {name}" for name, count in sorted(outcomes.items())))
+    for seed in seeds(__doc__.splitlines()[0]):
+        began = time.perf_counter()
+        signal.alarm(TIME_LIMIT)
+        try:
+            outcome = _run(seed)
+        except TimeoutError:
+            outcome = f"stopped after {TIME_LIMIT} s"
+        finally:
+            signal.alarm(0)
+        if outcome is None:
+            continue
+        took = time.perf_counter() - began
+        outcomes["ok" if outcome == "ok" else "failed"] += 1
+        if outcome != "ok" or took > 10:
+            print(f"seed {seed} ({took:.1f} s): {outcome}", flush=True)
+    print(summary(outcomes))
 
 
 if __name__ == "__main__":
