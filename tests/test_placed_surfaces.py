@@ -179,36 +179,56 @@ def test_other_sets_with_patches_have_no_exact_form(change, forces):
     assert ContactSetSurface(contacts, forces).as_limit_surface() is None
 
 
-def test_a_part_turning_about_a_pin_beside_a_pad_stops_as_the_closed_form_says():
+#: The pin and the pad's place of the part turning about the pin.
+PIN, PAD_AT = np.array([-0.03, 0.0]), np.array([0.02, 0.01])
+#: The unit rotation about the pin, and the pad's own twist in it (the velocity at its place).
+ABOUT_PIN = np.array([PIN[1], -PIN[0], 1.0])
+AT_PAD = np.array([ABOUT_PIN[0] - PAD_AT[1], ABOUT_PIN[1] + PAD_AT[0], 1.0])
+
+
+def _exact_pad_moment() -> float:
+    """The exact pad's friction moment about the pin: the pad built where it lies."""
+    pad = LimitSurface(world_polygon(PAD, Pose(offset=tuple(PAD_AT))), mu=0.4, normal_force=0.5)
+    return float(pad.support(ABOUT_PIN))
+
+
+def _ellipsoid_pad_moment() -> float:
+    """The ellipsoid pad's: ``N sqrt(u^T A^-1 u)`` at its own twist ``u``."""
+    matrix = Ellipsoid.from_limit_surface(LimitSurface(PAD, mu=0.4, normal_force=1.0)).load_matrix
+    return float(0.5 * np.sqrt(AT_PAD @ np.linalg.solve(matrix, AT_PAD)))
+
+
+@pytest.mark.parametrize(
+    ("model", "moment"), [("exact", _exact_pad_moment), ("ellipsoid", _ellipsoid_pad_moment)]
+)
+def test_a_part_turning_about_a_pin_beside_a_pad_stops_as_the_closed_form_says(model, moment):
     """Turning about a strong pin, a part decelerates by the pad's friction moment about the
-    pin, ``M = h_pad(V)`` at the unit rotation about it: it stops at ``ω0 I_pin / M`` having
-    turned ``ω0² I_pin / (2 M)``, its pin still. Before, each call of the forward map was a
-    conic solve (and the pad its seed polytope): such runs ended in a ConvergenceError after
-    about 2 minutes."""
-    pin, pad_at = np.array([-0.03, 0.0]), np.array([0.02, 0.01])
+    pin, ``M = h_pad(V)`` at the unit rotation about it (the exact pad's, or its Ellipsoid
+    model's): it stops at ``ω0 I_pin / M`` having turned ``ω0² I_pin / (2 M)``, its pin still.
+    Before, each call of the forward map was a conic solve (and an exact pad its seed
+    polytope): such runs ended in a ConvergenceError after 116 s (exact) and 151 s
+    (ellipsoid)."""
     contacts = [
-        Contact(name="pin", role="support", position=[*pin, 0.0], normal=[0, 0, 1], mu=0.5,
+        Contact(name="pin", role="support", position=[*PIN, 0.0], normal=[0, 0, 1], mu=0.5,
                 model="point-cone"),
-        Contact(name="pad", role="support", position=[*pad_at, 0.0], normal=[0, 0, 1],
-                mu=0.4, model="exact", patch=PAD),
+        Contact(name="pad", role="support", position=[*PAD_AT, 0.0], normal=[0, 0, 1],
+                mu=0.4, model=model, patch=PAD),
     ]  # fmt: skip
     surface = ContactSetSurface(contacts, [20.0, 0.5])
+    assert surface.as_limit_surface() is not None
     mass, inertia, spin = 1.0, 1e-3, 3.0
-    about_pin = np.array([pin[1], -pin[0], 1.0])  # (the unit rotation about the pin)
-    moved = slide(surface, mass=mass, inertia=inertia, twist0=spin * about_pin, duration=1.0)
-    pad = LimitSurface(world_polygon(PAD, Pose(offset=tuple(pad_at))), mu=0.4, normal_force=0.5)
-    moment = pad.support(about_pin)
-    turning_inertia = inertia + mass * pin @ pin
+    moved = slide(surface, mass=mass, inertia=inertia, twist0=spin * ABOUT_PIN, duration=1.0)
+    turning_inertia = inertia + mass * PIN @ PIN
     assert [index for _, _, index in moved.pivots] == [0]
     # (It is put at rest where its speed falls below STOP_RTOL of the run's speed scale, the
     # 10.2 m/s its friction takes away in 1 s: 3.2e-7 rad/s at the radius of gyration, which
     # it loses in 1.2e-7 s; its angle stands still there to second order.)
-    assert moved.stopped == pytest.approx(spin * turning_inertia / moment, rel=2e-7)
-    assert moved.poses[-1, 2] == pytest.approx(spin**2 * turning_inertia / (2 * moment),
+    assert moved.stopped == pytest.approx(spin * turning_inertia / moment(), rel=2e-7)
+    assert moved.poses[-1, 2] == pytest.approx(spin**2 * turning_inertia / (2 * moment()),
                                                rel=1e-12)  # fmt: skip
     angle = moved.poses[-1, 2]
     turn = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
-    np.testing.assert_allclose(moved.poses[-1, :2] + turn @ pin, pin, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(moved.poses[-1, :2] + turn @ PIN, PIN, rtol=0, atol=1e-12)
 
 
 def test_an_ellipsoid_surface_is_its_model_in_closed_form():
@@ -253,31 +273,6 @@ def test_an_ellipsoid_surface_is_its_model_in_closed_form():
 def test_an_ellipsoid_surface_refuses_a_matrix_that_is_no_ellipsoid(matrix, message):
     with pytest.raises(InvalidArgumentError, match=message):
         LimitSurface.ellipsoid(matrix, normal_force=1.0)
-
-
-def test_a_part_turning_about_a_pin_beside_an_ellipsoid_pad_stops_as_the_closed_form_says():
-    """As beside an exact pad (above), with the pad's Ellipsoid model: its friction moment about
-    the pin is ``N sqrt(u^T A^-1 u)`` at the pad's own twist ``u`` of the unit rotation about the
-    pin."""
-    pin, pad_at = np.array([-0.03, 0.0]), np.array([0.02, 0.01])
-    contacts = [
-        Contact(name="pin", role="support", position=[*pin, 0.0], normal=[0, 0, 1], mu=0.5,
-                model="point-cone"),
-        Contact(name="pad", role="support", position=[*pad_at, 0.0], normal=[0, 0, 1],
-                mu=0.4, model="ellipsoid", patch=PAD),
-    ]  # fmt: skip
-    surface = ContactSetSurface(contacts, [20.0, 0.5])
-    assert surface.as_limit_surface() is not None
-    mass, inertia, spin = 1.0, 1e-3, 3.0
-    about_pin = np.array([pin[1], -pin[0], 1.0])
-    moved = slide(surface, mass=mass, inertia=inertia, twist0=spin * about_pin, duration=1.0)
-    own = np.array([about_pin[0] - pad_at[1], about_pin[1] + pad_at[0], 1.0])  # (at the pad)
-    matrix = Ellipsoid.from_limit_surface(LimitSurface(PAD, mu=0.4, normal_force=1.0)).load_matrix
-    moment = 0.5 * np.sqrt(own @ np.linalg.solve(matrix, own))
-    turning_inertia = inertia + mass * pin @ pin
-    assert [index for _, _, index in moved.pivots] == [0]
-    assert moved.poses[-1, 2] == pytest.approx(spin**2 * turning_inertia / (2 * moment),
-                                               rel=1e-12)  # fmt: skip
 
 
 def test_a_placed_tactile_grid_and_a_placed_sum_are_their_parts_built_in_the_other_frame():
