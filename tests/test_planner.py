@@ -411,37 +411,24 @@ def test_solutions_are_verified_without_warnings():
     assert plan.residual < 1e-7
 
 
-def test_contact_set_surface_of_a_plan_holds_what_the_plan_says_is_at_the_limit():
-    xy = np.array([[0.03, 0.0], [-0.02, 0.025], [-0.02, -0.03]])
-    contacts = [
-        Contact(name=f"p{k}", role="support", position=[x, y, 0], normal=[0, 0, 1], mu=MU,
-                model="point-cone")
-        for k, (x, y) in enumerate(xy)
-    ]  # fmt: skip
-    problem = Problem(
-        body=Body(mass=2.0, center_of_mass=[0.0, 0.0, 0.05]), contacts=contacts, loads=[PUSH],
-        objective="max-safety-factor",
-    )  # fmt: skip
-    plan = solve(problem)
-    surface = ContactSetSurface.from_plan(problem, plan, "push")
-    # At the state of impending slip the push, scaled by its safety factor, is on the surface.
-    scaled = plan.safety_factors["push"] * planar_load(PUSH)
-    assert surface.safety_factor(scaled) == pytest.approx(1.0, rel=1e-6)
-
-
-@pytest.mark.parametrize("pad", ["exact", "ellipsoid"])
-def test_the_contact_set_of_a_plan_with_exact_pads_holds_its_impending_slip_on_its_surface(pad):
-    """Two rectangular pads (turned, off their frames' origins; one exact, the other exact or an
-    ellipsoid) and a pin: the plan's impending slip lies on the set's exact form to 1e-7 (7e-9
-    and 3e-9 measured). With each exact pad its seed polytope, as before, the set held it with a
-    safety factor of 1.041 and 1.029."""
+@pytest.mark.parametrize(
+    "models",
+    [("point-cone", "point-cone", "point-cone"), ("exact", "exact", "point-cone"),
+     ("ellipsoid", "exact", "point-cone")],
+)  # fmt: skip
+def test_contact_set_surface_of_a_plan_holds_what_the_plan_says_is_at_the_limit(models):
+    """At the state of impending slip the push, scaled by its safety factor, is on the surface
+    of the plan's contacts, to 1e-7: three pins; or two rectangular pads (turned, off their
+    frames' origins; exact, or one an ellipsoid) and a pin (7e-9 and 3e-9 measured; with each
+    exact pad its seed polytope, as before, the set held it with a safety factor of 1.041 and
+    1.029)."""
     patch = pressure.rectangle(0.02, 0.01).shifted(0.002, 0.0)
-    places = [([0.03, 0.0], pad), ([-0.02, 0.025], "exact"), ([-0.02, -0.03], "point-cone")]
+    xy = [[0.03, 0.0], [-0.02, 0.025], [-0.02, -0.03]]
     contacts = [
         Contact(name=f"p{k}", role="support", position=[x, y, 0], normal=[0, 0, 1], mu=MU,
                 model=model, patch=None if model == "point-cone" else patch,
                 axis=[np.cos(0.3), np.sin(0.3), 0.0])
-        for k, ((x, y), model) in enumerate(places)
+        for k, ((x, y), model) in enumerate(zip(xy, models, strict=True))
     ]  # fmt: skip
     problem = Problem(
         body=Body(mass=2.0, center_of_mass=[0.0, 0.0, 0.05]), contacts=contacts, loads=[PUSH],
