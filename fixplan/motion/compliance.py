@@ -79,6 +79,7 @@ from fixplan.motion.contact_springs import (
 )
 from fixplan.motion.load_ramp import LoadRamp, State
 from fixplan.planner.contact_models import contact_models
+from fixplan.planner.osculating_contact import osculates
 from fixplan.planner.plan import Plan
 from fixplan.planner.problem import PASSIVE_ROLES, Contact, Problem
 from fixplan.tolerances import MAX_SAFETY_FACTOR
@@ -289,7 +290,7 @@ def _warn_of_exact_models(names, models) -> None:
     """Warn where contacts with friction have exact models with facets: the steps state their
     seed polytopes (see the module doc)."""
     exact = [(n, m) for n, m in zip(names, models, strict=True)
-             if isinstance(m, Exact) and not m.frictionless and m.surface.has_facets]  # fmt: skip
+             if isinstance(m, Exact) and not m.frictionless and not osculates(m)]  # fmt: skip
     if exact:
         gap = max(m.constraint_error for _, m in exact)
         warnings.warn(

@@ -25,8 +25,8 @@ solves it with Clarabel. An exact friction model's set is stated by an ellipsoid
 (``R`` a Parameter) that osculates the exact set (same point, tangent plane and curvature;
 :meth:`~fixplan.models.Exact.osculating`) where the ray of the step's load meets it, moved after
 each solve until every exact contact's load is inside its exact set and, where its ellipsoid
-holds it back, at the point the ellipsoid osculates: there the step meets the exact problem's
-optimality conditions (sequential convex programming with exact second-order models, as the
+holds it back, on the exact surface with the ellipsoid's normal there the exact surface's: there
+the step meets the exact problem's optimality conditions (sequential convex programming with exact second-order models, as the
 planner's rounds, :mod:`fixplan.planner.osculating`). One with facets keeps its seed polytope.
 :class:`SpringSystem` solves purely elastic steps exactly: the QP (with unlimited friction,
 except none at lifted contacts) tells which contacts touch, and with that set fixed the step is
@@ -43,9 +43,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from fixplan.errors import ConvergenceError, InvalidArgumentError
-from fixplan.models import Exact
 from fixplan.planner.direct_solve import INFEASIBLE, DirectSolver
-from fixplan.planner.osculating_contact import MAX_OSCULATING_ROUNDS, OsculatingContact
+from fixplan.planner.osculating_contact import (
+    MAX_OSCULATING_ROUNDS,
+    OsculatingContact,
+    osculates,
+)
 from fixplan.planner.parameters import assign
 
 #: A polished solution is accepted when its equilibrium residual, negative normal forces and
@@ -144,7 +147,7 @@ class ContactQP:
                 load = cp.hstack([u[p] * forces[4 * i + p] for p in (1, 2, 3)])
             else:
                 load = cp.hstack([u[p] * forces[4 * i + p] for p in (1, 2)])
-            if isinstance(model, Exact) and not model.surface.has_facets:
+            if osculates(model):
                 self._osculating[i] = OsculatingContact(model)
                 constraints.append(self._osculating[i].constraint(load, self.bound[i]))
             else:

@@ -29,7 +29,11 @@ import numpy as np
 from fixplan.errors import ConvergenceError, FixplanError, InvalidArgumentError
 from fixplan.models import Ellipsoid, Exact, FittedEllipsoid, PointCone
 from fixplan.planner.contact_models import contact_models
-from fixplan.planner.osculating_contact import MAX_OSCULATING_ROUNDS, OsculatingContact
+from fixplan.planner.osculating_contact import (
+    MAX_OSCULATING_ROUNDS,
+    OsculatingContact,
+    osculates,
+)
 from fixplan.planner.problem import Contact
 from fixplan.surface import pressure
 from fixplan.surface.geometry import Pose
@@ -286,9 +290,7 @@ class _ConicPrograms:
         }
         #: Their ellipsoids in the gauge, but for those with facets (their seed polytopes).
         self._ellipsoids = {
-            i: OsculatingContact(model)
-            for i, (model, _) in self._exact.items()
-            if not model.surface.has_facets
+            i: OsculatingContact(model) for i, (model, _) in self._exact.items() if osculates(model)
         }
         constraints, others, wrench = [], [], 0
         for i, (load, model, fn) in enumerate(zip(self._loads, models, forces, strict=True)):

@@ -39,6 +39,12 @@ ACTIVE_RTOL = 1e-7
 NORMAL_RTOL = 1e-8
 
 
+def osculates(model) -> bool:
+    """Whether ``model`` is stated by an :class:`OsculatingContact`: an exact model with
+    friction and no facets (at a point support no ellipsoid osculates its set)."""
+    return isinstance(model, Exact) and not model.frictionless and not model.surface.has_facets
+
+
 class OsculatingContact:
     """An exact contact's friction set in a small cvxpy program of its own: the ellipsoid
     ``‖R ℓ‖ <= g`` (``R`` a Parameter, per unit normal force; first the axis ellipsoid) that
