@@ -207,16 +207,16 @@ def test_zero_loads_in_a_batch_are_held_with_no_motion():
     assert np.all(np.isfinite(motions[1])) and math.isfinite(safety[1])
 
 
-def test_kernels_without_a_compiled_form_keep_the_numpy_path():
+def test_kernels_with_a_part_without_a_compiled_form_keep_the_numpy_path():
     points = PointSetKernel(np.array([[0.0, 0.0], [0.01, 0.0]]), np.array([0.5, 0.5]), True)
     disk = DiskKernel(0.01, "uniform")
     pose = pressure.disk(0.01).shifted(0.01, 0.0).pose
-    assert compile_kernel(SumKernel((disk, points), (1.0, 1.0))) is None
-    assert compile_kernel(PosedKernel(points, pose)) is None  # facets live in the contact frame
+    varying = LimitSurface(pressure.disk(0.01), mu=lambda x, y: 0.3 + 0.0 * x)._kernel
     assert compile_kernel(points.smoothed(1e-3)) is None
-    assert compile_kernel(points) is not None
-    assert compile_kernel(disk) is not None
-    assert compile_kernel(PosedKernel(disk, pose)) is not None
+    assert compile_kernel(SumKernel((disk, varying), (1.0, 1.0))) is None
+    for kernel in (points, disk, PosedKernel(disk, pose), PosedKernel(points, pose),
+                   SumKernel((disk, points), (1.0, 2.0))):  # fmt: skip
+        assert compile_kernel(kernel) is not None
 
 
 def test_the_convergence_error_names_the_load_and_what_to_do():

@@ -1,4 +1,4 @@
-r"""The inverse map compiled whole, for point sets and piecewise-uniform polygons.
+r"""The inverse map compiled whole, for point sets, polygons, grids, disks, ellipsoids and sums.
 
 One numba loop per load runs the method of :mod:`fixplan.surface.inverse`: damped Newton on the
 plane ``L·V = 1`` from the ellipsoid's twist, then (point supports) the exact facet tests of the
@@ -8,12 +8,19 @@ iteration is gone (a few microseconds per query on a few points instead of half 
 and next to the kinks of point supports Newton stops sooner (:data:`STALLED_DECREMENT`): the
 answers agree with the NumPy path's to rounding.
 
-Kernels are passed as a tuple ``(kind, x, y, weights, edges, reach, transform, posed)``: points
-``x``, ``y`` [m] with friction ``weights`` (the far-field rule of a polygon or grid), the
-polygon's edge table ``(7, E)`` (``kind`` :data:`~fixplan.surface.closed_form.EDGES`) or the grid's node table ``(3, N)``
-(``kind`` :data:`~fixplan.surface.closed_form.NODES`) with its far-field radius ``reach`` [m], or the disk table ``(3, D)``
-in its place (``kind`` :data:`DISKS`), and the ``transform`` (3x3) from contact-frame to local
-twists when ``posed``.
+A kernel is passed as one flat tuple (numba's parallel loops take no nested ones): a table of
+its summed parts ``(kinds, weights, transforms, posed, point_bounds, x, y, point_weights,
+table_bounds, table_rows, tables, reach)``, then its facets. Part ``c`` of kind ``kinds[c]`` is
+weighed by ``weights[c]`` and sees the local twist ``transforms[c] @ V`` (where ``posed[c]``).
+Its points ``x``, ``y`` [m] with friction ``point_weights`` (a point set, or the far-field rule
+of a polygon or grid) lie between ``point_bounds[c]`` and ``point_bounds[c + 1]``; its table
+(``table_rows[c]`` rows, flattened) between ``table_bounds[c]`` and ``table_bounds[c + 1]`` of
+``tables``: the polygon's edge table ``(7, E)`` (``kind``
+:data:`~fixplan.surface.closed_form.EDGES`) or the grid's node table ``(3, N)`` (``kind``
+:data:`~fixplan.surface.closed_form.NODES`), both with the far-field radius ``reach[c]`` [m],
+or the disk table ``(3, D)`` (``kind`` :data:`DISKS`). An ellipsoid is the unit ball
+(:data:`BALL`) through its factor. The facets ``(x, y, friction)`` (from :data:`FACETS` on) are
+the discrete point supports in the contact frame, which are also the first part.
 
 The per-twist terms come from :mod:`~fixplan.surface.point_kernel`,
 :mod:`~fixplan.surface.polygon_kernel`, :mod:`~fixplan.surface.grid_kernel` and
@@ -35,7 +42,13 @@ from fixplan.errors import ConvergenceError, InvalidArgumentError
 from fixplan.surface.closed_form import _NEAR_TERMS, ClosedFormKernel
 from fixplan.surface.disk_compiled import _DISK_TERMS, PROFILES
 from fixplan.surface.disk_kernel import AnnulusKernel, DiskKernel
-from fixplan.surface.kernels import PosedKernel, SupportKernel, twist_to_local
+from fixplan.surface.kernels import (
+    EllipsoidKernel,
+    PosedKernel,
+    SumKernel,
+    SupportKernel,
+    twist_to_local,
+)
 from fixplan.surface.point_kernel import (
     _POINT_TERMS,
     PointSetKernel,
@@ -51,11 +64,15 @@ from fixplan.tolerances import (
     INVERSE_RTOL,
 )
 
-#: Kinds of compiled kernels: weighted points, polygon edges or grid nodes with a far-field
-#: point rule, or closed-form disks.
+#: Kinds of compiled parts: weighted points, polygon edges or grid nodes with a far-field
+#: point rule, closed-form disks, or the unit ball (an ellipsoid through its transform).
 POINTS = 0
 DISKS = 2
+BALL = 4
 # EDGES = 1 and NODES = 3: see fixplan.surface.closed_form.
+
+#: Where a kernel's facets ``(x, y, friction)`` start in its tuple (see the module).
+FACETS = 12
 
 #: Number of nearest support points whose facets are tested per query.
 FACETS_TESTED = 3
@@ -116,40 +133,78 @@ START_MAX_ANGLE = math.acos(0.1)
 def _terms(kernel, eps2, twist, with_hessian, local, out):  # pragma: no cover - compiled
     """Support value, gradient and (``with_hessian``) Hessian of the unit-friction ``kernel`` at
     the contact-frame ``twist`` (3,) [m/s, rad/s], in ``out`` (10,) as ``point_terms`` writes
-    them; ``local`` (10,) is scratch. ``eps2`` [m²/s²] smooths the speeds of points."""
-    kind, px, py, pw, edges, reach, transform, posed = kernel
-    vx, vy, w = twist[0], twist[1], twist[2]
-    if posed:
-        t = transform
-        vx, vy, w = (
-            t[0, 0] * twist[0] + t[0, 1] * twist[1] + t[0, 2] * twist[2],
-            t[1, 0] * twist[0] + t[1, 1] * twist[1] + t[1, 2] * twist[2],
-            t[2, 0] * twist[0] + t[2, 1] * twist[1] + t[2, 2] * twist[2],
-        )
-    target = local if posed else out
-    if kind == DISKS:
-        _DISK_TERMS(edges, vx, vy, w, with_hessian, target)
-    elif kind != POINTS and abs(w) * reach > math.sqrt(vx * vx + vy * vy):
-        _NEAR_TERMS(kind, edges, vx, vy, w, with_hessian, target)
-    else:
-        _POINT_TERMS(px, py, pw, eps2, vx, vy, w, with_hessian, target)
-    if not posed:
+    them (without the Hessian, ``out[4:]`` is left as it was); ``local`` (10,) is scratch.
+    ``eps2`` [m²/s²] smooths the speeds of points. The parts' terms are summed, each at its
+    local twist ``T V`` and weighed: ``g = w Tᵀ g_local``, ``H = w Tᵀ H_local T``."""
+    kinds, weights, transforms, posed = kernel[0], kernel[1], kernel[2], kernel[3]
+    if kinds.shape[0] == 1 and not posed[0] and weights[0] == 1.0:
+        _part_terms(kernel, 0, eps2, twist[0], twist[1], twist[2], with_hessian, out)
         return
-    # g = Tᵀ g_local, H = Tᵀ H_local T.
-    t = transform
-    out[0] = local[0]
-    for i in range(3):
-        out[1 + i] = t[0, i] * local[1] + t[1, i] * local[2] + t[2, i] * local[3]
-    if not with_hessian:
-        return
+    last = 10 if with_hessian else 4
+    for i in range(last):
+        out[i] = 0.0
     hl = np.empty((3, 3))
-    _unpack(local, hl)
-    for slot, (i, j) in enumerate(((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))):
-        total = 0.0
-        for a in range(3):
-            for b in range(3):
-                total += t[a, i] * hl[a, b] * t[b, j]
-        out[4 + slot] = total
+    for part in range(kinds.shape[0]):
+        t = transforms[part]
+        vx, vy, w = twist[0], twist[1], twist[2]
+        if posed[part]:
+            vx, vy, w = (
+                t[0, 0] * twist[0] + t[0, 1] * twist[1] + t[0, 2] * twist[2],
+                t[1, 0] * twist[0] + t[1, 1] * twist[1] + t[1, 2] * twist[2],
+                t[2, 0] * twist[0] + t[2, 1] * twist[1] + t[2, 2] * twist[2],
+            )
+        _part_terms(kernel, part, eps2, vx, vy, w, with_hessian, local)
+        weight = weights[part]
+        out[0] += weight * local[0]
+        if not posed[part]:
+            for i in range(1, last):
+                out[i] += weight * local[i]
+            continue
+        for i in range(3):
+            out[1 + i] += weight * (t[0, i] * local[1] + t[1, i] * local[2] + t[2, i] * local[3])
+        if not with_hessian:
+            continue
+        _unpack(local, hl)
+        for slot, (i, j) in enumerate(((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))):
+            total = 0.0
+            for a in range(3):
+                for b in range(3):
+                    total += t[a, i] * hl[a, b] * t[b, j]
+            out[4 + slot] += weight * total
+
+
+def _part_terms(kernel, part, eps2, vx, vy, w, with_hessian, out):  # pragma: no cover - compiled
+    """:func:`_terms` of one ``part`` of the ``kernel`` at its local twist ``(vx, vy, w)``,
+    unweighed."""
+    kinds, point_bounds, px, py, pw = kernel[0], kernel[4], kernel[5], kernel[6], kernel[7]
+    table_bounds, table_rows, tables, reach = kernel[8], kernel[9], kernel[10], kernel[11]
+    kind = kinds[part]
+    if kind == BALL:
+        _ball_terms(vx, vy, w, with_hessian, out)
+        return
+    if kind != POINTS:
+        start, stop, rows = table_bounds[part], table_bounds[part + 1], table_rows[part]
+        table = tables[start:stop].reshape((rows, (stop - start) // rows))
+        if kind == DISKS:
+            _DISK_TERMS(table, vx, vy, w, with_hessian, out)
+            return
+        if abs(w) * reach[part] > math.sqrt(vx * vx + vy * vy):
+            _NEAR_TERMS(kind, table, vx, vy, w, with_hessian, out)
+            return
+    start, stop = point_bounds[part], point_bounds[part + 1]
+    _POINT_TERMS(px[start:stop], py[start:stop], pw[start:stop], eps2, vx, vy, w, with_hessian,
+                 out)  # fmt: skip
+
+
+def _ball_terms(vx, vy, w, with_hessian, out):  # pragma: no cover - compiled
+    """The terms of the unit ball's support ``h(u) = |u|`` at ``u = (vx, vy, w)``: ``g = u / h``,
+    ``H = (I - g gᵀ) / h`` (an ellipsoid's, through its part's transform)."""
+    h = math.sqrt(vx * vx + vy * vy + w * w)
+    g0, g1, g2 = vx / h, vy / h, w / h
+    out[0], out[1], out[2], out[3] = h, g0, g1, g2
+    if with_hessian:
+        out[4], out[5], out[6] = (1.0 - g0 * g0) / h, -g0 * g1 / h, -g0 * g2 / h
+        out[7], out[8], out[9] = (1.0 - g1 * g1) / h, -g1 * g2 / h, (1.0 - g2 * g2) / h
 
 
 def _unpack(terms, hess):  # pragma: no cover - compiled
@@ -274,7 +329,7 @@ def _slowest_point(kernel, twist):  # pragma: no cover - compiled
 def _slowest(kernel, twist, index, speed):  # pragma: no cover - compiled
     """Indices ``index`` (n,) of the points with the least weighted speed under ``twist``, and
     those speeds ``|v_i| * weight_i`` in ``speed``, slowest first."""
-    _, px, py, pw, _, _, _, _ = kernel
+    px, py, pw = kernel[FACETS:]
     count = index.shape[0]
     speed[:] = np.inf
     index[:] = -1
@@ -297,7 +352,7 @@ def _facet(kernel, load, scale, k, twist, with_hessian, terms):  # pragma: no co
     does not lie on it (the force point ``k`` must carry to balance it is above its friction
     limit), NaN where the facet is parallel to the load. The facet's twist (on the plane
     ``L·V = 1``) is left in ``twist`` and the terms of the other points there in ``terms``."""
-    _, px, py, pw, _, _, _, _ = kernel
+    px, py, pw = kernel[FACETS:]
     twist[0], twist[1], twist[2] = py[k], -px[k], 1.0
     power = load[0] * twist[0] + load[1] * twist[1] + load[2]
     if power == 0.0:
@@ -313,7 +368,7 @@ def _facet(kernel, load, scale, k, twist, with_hessian, terms):  # pragma: no co
 def _facets(kernel, load, scale, twist, safety):  # pragma: no cover - compiled
     """The safety factor on the facets of the slowest support points where ``load`` lies on
     one (``twist`` is then set to the facet's twist), else ``safety``; and whether it does."""
-    count = min(FACETS_TESTED, kernel[1].shape[0])
+    count = min(FACETS_TESTED, kernel[FACETS].shape[0])
     index = np.empty(count, dtype=np.int64)
     speed = np.empty(count)
     _slowest(kernel, twist, index, speed)
@@ -332,7 +387,7 @@ def _facets(kernel, load, scale, twist, safety):  # pragma: no cover - compiled
 def _nearest_kink(kernel, twist, step):  # pragma: no cover - compiled
     """The support point that comes nearest to standing still (least weighted speed) on the
     segment from ``twist`` to ``twist + step``: the kink a rejected Newton step crosses."""
-    _, px, py, pw, _, _, _, _ = kernel
+    px, py, pw = kernel[FACETS:]
     best = np.inf
     nearest = 0
     for i in range(px.shape[0]):
@@ -379,7 +434,7 @@ def _escape_kink(kernel, twist, b1, b2, k, facet, rest):  # pragma: no cover - c
     ``h(F) - r |g_u| + w_k r + r² dᵀHd / 2``, least at ``r = (|g_u| - w_k) / dᵀHd``: a start
     on the smooth side of the kink, from which Newton converges quadratically.
     """
-    _, px, py, pw, _, _, _, _ = kernel
+    px, py, pw = kernel[FACETS:]
     m00 = b1[0] - b1[2] * py[k]
     m10 = b1[1] + b1[2] * px[k]
     m01 = b2[0] - b2[2] * py[k]
@@ -426,7 +481,7 @@ def _terms_near_facet(kernel, k, facet, rest, hess, twist, out):  # pragma: no c
     cubed, which :func:`_escape_kink` takes at about 1e-7 of the twist near the facets of 4,096
     points), point ``k``'s exactly. Saves a pass over the points (one of about seven of such a
     query), as Newton's first step from ``twist`` needs these terms only."""
-    _, px, py, pw, _, _, _, _ = kernel
+    px, py, pw = kernel[FACETS:]
     step = np.empty(3)
     moved = np.zeros(3)
     for i in range(3):
@@ -650,6 +705,8 @@ def _hessians(kernel, twists, out):  # pragma: no cover - compiled
         _unpack(terms, out[k])
 
 
+_ball_terms = compiled_scalar(_ball_terms)
+_part_terms = compiled_scalar(_part_terms)
 _terms = compiled_scalar(_terms)
 _unpack = compiled_scalar(_unpack)
 _supports = compiled_scalar(_supports)
@@ -766,28 +823,85 @@ DISK_WORK = 64
 
 
 def compile_kernel(kernel: SupportKernel) -> CompiledKernel | None:
-    """The compiled form of a point-set, polygon or disk kernel, posed or not (``None`` for
-    others, which take the NumPy path)."""
-    transform, posed = np.eye(3), False
+    """The compiled form of a point-set, polygon, grid, disk or ellipsoid kernel, or of a sum
+    of them, posed or not (``None`` where any part is another kernel: those take the NumPy
+    path). The parts are flattened into one table: each with its weight and the transform
+    from contact-frame to local twists; discrete point supports become one part of points in
+    the contact frame, the kernel's (merged) facets, which the facet tests read too."""
+    parts: list[tuple] = []
+    if not _flatten(kernel, np.eye(3), 1.0, parts):
+        return None
+    points, friction = kernel.facets
+    discrete = len(friction) > 0
+    if discrete:
+        points = np.asarray(points, dtype=float).reshape(-1, 2)
+        facets = (points[:, 0].copy(), points[:, 1].copy(), np.array(friction, dtype=float))
+        parts.insert(0, (POINTS, 1.0, np.eye(3), *facets, _NO_TABLE, 0.0, len(friction)))
+    else:
+        facets = (np.empty(0), np.empty(0), np.empty(0))
+    kinds, weights, transforms, xs, ys, ws, tables, reach, work = zip(*parts, strict=True)
+    table = (
+        np.array(kinds, dtype=np.int64),
+        np.array(weights, dtype=float),
+        np.array(transforms, dtype=float).reshape(-1, 3, 3),
+        np.array([not np.array_equal(t, np.eye(3)) for t in transforms]),
+        _bounds([len(x) for x in xs]),
+        np.concatenate(xs),
+        np.concatenate(ys),
+        np.concatenate(ws),
+        _bounds([t.size for t in tables]),
+        np.array([t.shape[0] for t in tables], dtype=np.int64),
+        np.concatenate([t.ravel() for t in tables]),
+        np.array(reach, dtype=float),
+    )
+    return CompiledKernel(parts=(*table, *facets), discrete=discrete, work=sum(work))
+
+
+#: The table of a part without one (points, an ellipsoid).
+_NO_TABLE = np.empty((1, 0))
+_NO_POINTS = np.empty(0)
+
+
+def _flatten(kernel: SupportKernel, transform: np.ndarray, weight: float, out: list) -> bool:
+    """Append the parts of ``kernel`` (reached from the contact frame by ``transform`` (3x3,
+    contact-frame to local twists) and weighed by ``weight``) to ``out`` as ``(kind, weight,
+    transform, x, y, point weights, table, reach, work)``; whether every part compiles.
+    Discrete point supports are left out: they are the kernel's facets (see
+    :func:`compile_kernel`)."""
     if isinstance(kernel, PosedKernel):
-        transform, posed, kernel = twist_to_local(kernel.pose), True, kernel.local
-    no_edges = np.empty((7, 0))
-    no_points = np.empty(0)
+        return _flatten(kernel.local, twist_to_local(kernel.pose) @ transform, weight, out)
+    if isinstance(kernel, SumKernel):
+        return all(_flatten(part, transform, weight * scale, out)
+                   for part, scale in zip(kernel.parts, kernel.scales, strict=True))  # fmt: skip
+    if isinstance(kernel, PointSetKernel):
+        if kernel.smoothing != 0.0:
+            return False
+        if not kernel.discrete:
+            columns = _point_columns(kernel)
+            out.append((POINTS, weight, transform, *columns, _NO_TABLE, 0.0, len(columns[0])))
+        return True
     disks = _disk_table(kernel)
     if disks is not None:
-        parts = (DISKS, no_points, no_points, no_points, disks, 0.0, transform, posed)
-        return CompiledKernel(parts=parts, discrete=False, work=DISK_WORK * disks.shape[1])
-    if isinstance(kernel, PointSetKernel) and kernel.smoothing == 0.0:
-        if posed and kernel.discrete:
-            return None  # facets are tested in the contact frame
-        parts = (POINTS, *_point_columns(kernel), no_edges, 0.0, transform, posed)
-        return CompiledKernel(parts=parts, discrete=kernel.discrete, work=len(kernel.weights))
+        work = DISK_WORK * disks.shape[1]
+        out.append((DISKS, weight, transform, *(_NO_POINTS,) * 3, disks, 0.0, work))
+        return True
     if isinstance(kernel, ClosedFormKernel):
         table = np.array(kernel.table, dtype=float)
         reach = FAR_FIELD_RADII * kernel.size
-        parts = (kernel._KIND, *_point_columns(kernel.far), table, reach, transform, posed)
-        return CompiledKernel(parts=parts, discrete=False, work=kernel.work)
-    return None
+        columns = _point_columns(kernel.far)
+        out.append((kernel._KIND, weight, transform, *columns, table, reach, kernel.work))
+        return True
+    if isinstance(kernel, EllipsoidKernel):
+        # h(V) = sqrt(Vᵀ B V) = |C V| with B = Cᵀ C: the unit ball's, through C.
+        factor = np.linalg.cholesky(kernel.inverse).T
+        out.append((BALL, weight, factor @ transform, *(_NO_POINTS,) * 3, _NO_TABLE, 0.0, 1))
+        return True
+    return False
+
+
+def _bounds(sizes: list[int]) -> np.ndarray:
+    """Where each part's entries start in a concatenation of ``sizes``, and the end."""
+    return np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
 
 
 def _disk_table(kernel: SupportKernel) -> np.ndarray | None:
