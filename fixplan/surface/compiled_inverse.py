@@ -696,6 +696,16 @@ def _supports(kernel, twists, out):  # pragma: no cover - compiled
         out[k] = terms[0]
 
 
+def _loads(kernel, twists, out):  # pragma: no cover - compiled
+    """Loads (gradients) ``out`` ``(K, 3)`` of the unit-friction ``kernel`` at nonzero
+    ``twists`` ``(K, 3)``."""
+    local = np.empty(10)
+    terms = np.empty(10)
+    for k in range(twists.shape[0]):
+        _terms(kernel, 0.0, twists[k], False, local, terms)
+        out[k, :] = terms[1:4]
+
+
 def _hessians(kernel, twists, out):  # pragma: no cover - compiled
     """Support Hessians ``out`` ``(K, 3, 3)`` of the unit-friction ``kernel`` at ``twists``."""
     for k in numba.prange(twists.shape[0]):
@@ -710,6 +720,7 @@ _part_terms = compiled_scalar(_part_terms)
 _terms = compiled_scalar(_terms)
 _unpack = compiled_scalar(_unpack)
 _supports = compiled_scalar(_supports)
+_loads = compiled_scalar(_loads)
 _projected = compiled_scalar(_projected)
 _newton_step = compiled_scalar(_newton_step)
 _newton = compiled_scalar(_newton)
@@ -797,6 +808,12 @@ class CompiledKernel:
         """Values ``(K,)`` of the unit-friction support at ``twists`` ``(K, 3)``."""
         out = np.empty(len(twists))
         _supports(self.parts, np.ascontiguousarray(twists, dtype=float), out)
+        return out
+
+    def loads(self, twists: np.ndarray) -> np.ndarray:
+        """Loads ``(K, 3)`` of the unit-friction support at nonzero ``twists`` ``(K, 3)``."""
+        out = np.empty((len(twists), 3))
+        _loads(self.parts, np.ascontiguousarray(twists, dtype=float), out)
         return out
 
     def hessians(self, twists: np.ndarray) -> np.ndarray:

@@ -75,8 +75,8 @@ _FAR_ORDER = 12
 #: Loads are solved in chunks of this many to bound memory.
 _CHUNK = 4096
 
-#: Up to this many twists, the support function is evaluated by the compiled kernel one twist
-#: at a time (a Hertz disk: 1.8 µs for 2 twists and 14 µs for 64, against 49 and 59 µs of the
+#: Up to this many twists, the support function (and the load) is evaluated by the compiled
+#: kernel one twist at a time (a Hertz disk: 1.8 µs for 2 twists and 14 µs for 64, against 49 and 59 µs of the
 #: NumPy kernel; a rectangle: 1.9 and 19 µs against 2.8 and 25 µs); larger batches take the
 #: vectorised NumPy kernels.
 COMPILED_SUPPORT_MAX_TWISTS = 64
@@ -343,7 +343,11 @@ class LimitSurface:
         twists, single, zero = _vectors("twist", twist)
         if zero is not None:
             raise InvalidArgumentError(f"twist[{zero}] is zero: a body at rest has no sliding load")
-        loads = self._scale * self._kernel.evaluate(self._normalized(twists)[0])[1]
+        unit = self._normalized(twists)[0]
+        if self._compiled is not None and len(unit) <= COMPILED_SUPPORT_MAX_TWISTS:
+            loads = self._scale * self._compiled.loads(unit)
+        else:
+            loads = self._scale * self._kernel.evaluate(unit)[1]
         return loads[0] if single else loads
 
     def load_at_cor(self, cor, ccw: bool = True) -> np.ndarray:
