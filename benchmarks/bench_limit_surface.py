@@ -198,8 +198,9 @@ def per_call_surfaces() -> dict:
     }
 
 
-def load_distributions(surface, count: int, rng) -> dict:
-    """name: loads ``(count, 3)`` [N, N m] of each distribution of the per-call benchmark."""
+def load_distributions(surface, count: int, rng, points=None) -> dict:
+    """name: loads ``(count, 3)`` [N, N m] of each distribution of the per-call benchmark (near
+    the facets of the ``points`` ``(P, 2)`` [m], default the field's points, where any)."""
     rho = surface.characteristic_length
     twists = rng.normal(size=(count, 3)) * [1.0, 1.0, 1.0 / rho]
     directions = rng.normal(size=(count, 3)) * [1.0, 1.0, rho]
@@ -214,8 +215,8 @@ def load_distributions(surface, count: int, rng) -> dict:
         "far outside (x 1e6)": on_surface * 1e6,
         "deep inside (x 1e-6)": on_surface * 1e-6,
     }
-    points = getattr(surface.field, "xy", None)
-    if points is not None:
+    points = getattr(surface.field, "xy", None) if points is None else points
+    if points is not None and len(points):
         k = rng.integers(0, len(points), count)
         offsets = rng.normal(size=(count, 2)) * 1e-7 * rho
         near = surface.load_at_cor(points[k] + offsets) * rng.uniform(0.5, 1.5, (count, 1))
@@ -344,6 +345,81 @@ def _emit_per_call(new: dict, old: dict | None, ref: str) -> None:
         )
 
 
+def summed_surfaces() -> dict:
+    """Surfaces summed from parts (:meth:`LimitSurface.combine`): a contact set's exact form and
+    placed pads."""
+    from fixplan import Contact, ContactSetSurface
+    from fixplan.surface.geometry import Pose
+
+    pad = pressure.rectangle(0.03, 0.01).rotated(0.3)
+    contacts = [
+        Contact(name="pin", role="support", position=[-0.03, 0.0, 0.0], normal=[0, 0, 1],
+                mu=0.5, model="point-cone"),
+        Contact(name="pin 2", role="support", position=[0.01, 0.04, 0.0], normal=[0, 0, 1],
+                mu=0.5, model="point-cone"),
+        Contact(name="pad", role="support", position=[0.02, 0.01, 0.0], normal=[0, 0, 1],
+                mu=0.4, model="exact", patch=pad),
+        Contact(name="disk", role="support", position=[0.0, -0.03, 0.0], normal=[0, 0, 1],
+                mu=0.3, model="ellipsoid", patch=pressure.disk(0.01)),
+    ]  # fmt: skip
+    placed = [
+        LimitSurface(pad, mu=0.4, normal_force=30.0).placed(Pose(angle=0.3, offset=(0.02, 0.0))),
+        LimitSurface(pressure.disk(0.01, "hertz"), mu=0.5, normal_force=20.0).placed(
+            Pose(angle=0.0, offset=(-0.03, 0.01), mirrored=True)
+        ),
+    ]
+    return {
+        "2 pins, exact pad, ellipsoid pad": ContactSetSurface(
+            contacts, [3.0, 2.0, 5.0, 4.0]
+        ).as_limit_surface(),
+        "rectangle and Hertz disk, placed": LimitSurface.combine(placed),
+    }
+
+
+def bench_summed_surfaces(count: int, batch_repeats: int) -> None:
+    """The inverse map per call and batched on summed surfaces, compiled against the NumPy path
+    that summed them before (each part's own kernel per Newton step; restored in this run by
+    dropping the compiled kernel)."""
+    print(f"inverse map per call on summed surfaces, {count} loads per distribution; compiled "
+          "against the NumPy path (median | p99 per call; batch)")  # fmt: skip
+    for name, surface in summed_surfaces().items():
+        rng = np.random.default_rng(2)
+        distributions = load_distributions(surface, count, rng, surface.point_supports[0])
+        compiled, numpy, gaps = [], [], []
+        batch = {}
+        for way in ("compiled", "NumPy"):
+            if way == "NumPy":
+                surface._compiled = None
+            for loads in distributions.values():
+                times, safety = per_call_times(surface, loads)
+                (compiled if way == "compiled" else numpy).append((times, safety))
+            every = np.vstack(list(distributions.values()))
+            batch[way] = len(every) / median_time(
+                lambda s=surface, x=every: s.motion_and_safety_factor(x), batch_repeats
+            )
+        medians = [np.median(t) * 1e6 for t, _ in compiled]
+        tails = [np.percentile(t, 99) * 1e6 for t, _ in compiled]
+        ratios = [np.median(t) / np.median(c) for (t, _), (c, _) in zip(numpy, compiled,
+                                                                            strict=True)]  # fmt: skip
+        was = [np.median(t) * 1e6 for t, _ in numpy]
+        for (_, a), (_, b) in zip(compiled, numpy, strict=True):
+            finite = np.isfinite(a) & np.isfinite(b)
+            gaps.append(np.max(np.abs(a[finite] - b[finite]) / b[finite]))
+        print(f"  {name:36s} median {min(medians):.1f}-{max(medians):.1f} us, p99 "
+              f"{min(tails):.0f}-{max(tails):.0f} us; NumPy path median {min(was):,.0f}-"
+              f"{max(was):,.0f} us: x{min(ratios):.0f}-{max(ratios):.0f}; batch "
+              f"{batch['compiled']:,.0f} q/s against {batch['NumPy']:,.0f}; safety factors "
+              f"agree to {max(gaps):.1e}")  # fmt: skip
+        emit(
+            f"inverse map per call, summed: {name} ({len(distributions)} load distributions)",
+            f"median {min(medians):.1f}–{max(medians):.1f} µs, p99 {min(tails):.0f}–"
+            f"{max(tails):.0f} µs; batch {batch['compiled']:,.0f} queries/s",
+            f"NumPy path: median {min(was):,.0f}–{max(was):,.0f} µs; batch "
+            f"{batch['NumPy']:,.0f} queries/s",
+            f"{min(ratios):.0f}–{max(ratios):.0f}× (safety factors within {max(gaps):.0e})",
+        )
+
+
 def function_fields() -> dict:
     """Surfaces of users' pressure functions (integrated by adapted rules, not closed forms)."""
     return {
@@ -404,11 +480,13 @@ def main() -> None:
         bench_forward(2000, 2000, 3)
         bench_inverse(4096, 500, 3, 3)
         bench_per_call(200, 3, args.baseline)
+        bench_summed_surfaces(100, 3)
         bench_function_fields(50)
     else:
         bench_forward(10_000, 10_000, 5)
         bench_inverse(4096, 4000, 20, 5)
         bench_per_call(1000, 5, args.baseline)
+        bench_summed_surfaces(300, 3)
         bench_function_fields(300)
     bench_accuracy()
 
