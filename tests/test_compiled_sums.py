@@ -40,15 +40,22 @@ def pins():
     return LimitSurface(PINS, mu=0.3, normal_force=4.0)
 
 
+def nested_pad_and_pins():
+    turned = Pose(angle=-1.0, offset=(0.01, 0.0), mirrored=True)
+    return LimitSurface.combine([pad(), pins()]).placed(turned)
+
+
+def annulus_and_ellipsoid():
+    return LimitSurface.combine([LimitSurface(ANNULUS, mu=0.2), ellipsoid()])
+
+
 SUMS = {
     "pad and disk from above": lambda: LimitSurface.combine([pad(), disk_from_above()]),
     "pads and pins": lambda: LimitSurface.combine([pad(), disk_from_above(), pins()]),
     "pad, ellipsoid and pins": lambda: LimitSurface.combine([pad(), ellipsoid(), pins()]),
-    "sums of sums, placed": lambda: LimitSurface.combine([
-        LimitSurface.combine([pad(), pins()]).placed(Pose(angle=-1.0, offset=(0.01, 0.0),
-                                                          mirrored=True)),
-        LimitSurface.combine([LimitSurface(ANNULUS, mu=0.2), ellipsoid()]),
-    ]),  # fmt: skip
+    "sums of sums, placed": lambda: LimitSurface.combine(
+        [nested_pad_and_pins(), annulus_and_ellipsoid()]
+    ),
     "ellipsoid": ellipsoid,
 }
 
