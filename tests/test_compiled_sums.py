@@ -69,9 +69,9 @@ def loads_of(surface, count):
     if len(points):
         at = points[RNG.integers(len(points), size=count)]
         near = at + RNG.normal(size=(count, 2)) * 1e-9
-        scaled = RNG.uniform(0.5, 2.0, size=(count, 1))
-        loads = np.vstack([loads, surface.load_at_cor(near) * scaled,
-                           surface.load_at_cor(at) * 0.9 + RNG.normal(size=(count, 3)) * 1e-3 * units])  # fmt: skip
+        on_facets = surface.load_at_cor(near) * RNG.uniform(0.5, 2.0, size=(count, 1))
+        off_facets = surface.load_at_cor(at) * 0.9 + RNG.normal(size=(count, 3)) * 1e-3 * units
+        loads = np.vstack([loads, on_facets, off_facets])
     return loads
 
 
