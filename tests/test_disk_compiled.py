@@ -27,8 +27,8 @@ OUTSIDE_C = {"uniform": 2.0, "hertz": 2.5, "parabolic": 3.0, "ring": 1.0}
 
 def compiled_terms(kernel, twists):
     """``h``, loads ``(K, 3)`` and Hessians ``(K, 3, 3)`` of the compiled disk table."""
-    parts = compile_kernel(kernel).parts  # (one part: its table is the whole, 3 rows)
-    table = parts[10].reshape(parts[9][0], -1)
+    tables = compile_kernel(kernel).parts[6]  # (one part: its table is the whole, 3 rows)
+    table = np.ascontiguousarray(tables[:3])
     out = np.empty(10)
     h, loads, hessians = np.empty(len(twists)), np.empty((len(twists), 3)), []
     for k, (vx, vy, w) in enumerate(twists):

@@ -8,19 +8,19 @@ iteration is gone (a few microseconds per query on a few points instead of half 
 and next to the kinks of point supports Newton stops sooner (:data:`STALLED_DECREMENT`): the
 answers agree with the NumPy path's to rounding.
 
-A kernel is passed as one flat tuple (numba's parallel loops take no nested ones): a table of
-its summed parts ``(kinds, weights, transforms, posed, point_bounds, x, y, point_weights,
-table_bounds, table_rows, tables, reach)``, then its facets. Part ``c`` of kind ``kinds[c]`` is
-weighed by ``weights[c]`` and sees the local twist ``transforms[c] @ V`` (where ``posed[c]``).
-Its points ``x``, ``y`` [m] with friction ``point_weights`` (a point set, or the far-field rule
-of a polygon or grid) lie between ``point_bounds[c]`` and ``point_bounds[c + 1]``; its table
-(``table_rows[c]`` rows, flattened) between ``table_bounds[c]`` and ``table_bounds[c + 1]`` of
-``tables``: the polygon's edge table ``(7, E)`` (``kind``
-:data:`~fixplan.surface.closed_form.EDGES`) or the grid's node table ``(3, N)`` (``kind``
-:data:`~fixplan.surface.closed_form.NODES`), both with the far-field radius ``reach[c]`` [m],
-or the disk table ``(3, D)`` (``kind`` :data:`DISKS`). An ellipsoid is the unit ball
-(:data:`BALL`) through its factor. The facets ``(x, y, friction)`` (from :data:`FACETS` on) are
-the discrete point supports in the contact frame, which are also the first part.
+A kernel is passed as a tuple (its entries named by :data:`WHOLE` to :data:`TABLES`) of three
+arrays and a few numbers: a table of its summed parts (one row each, its columns named by
+:data:`KIND` to :data:`TRANSFORM`), the points' columns ``(3, P)`` (``x``, ``y`` [m] and
+friction: point sets, and the far-field rules of polygons and grids) and the tables
+``(TABLE_ROWS, T)``: the polygons' edge tables ``(7, E)`` (kind
+:data:`~fixplan.surface.closed_form.EDGES`), the grids' node tables ``(3, N)`` (kind
+:data:`~fixplan.surface.closed_form.NODES`), both with their far-field radius, and the disk
+tables ``(3, D)`` (kind :data:`DISKS`), the shorter ones padded. A part is weighed by its weight
+and sees the local twist ``T V`` of its transform ``T`` (where posed); its points and table are
+the ranges of columns its row names. An ellipsoid is the unit ball (:data:`BALL`) through its
+factor. The discrete point supports, the facets, are the first :data:`FACET_COUNT` points: one
+part in the contact frame. A kernel of one part, unposed and of weight 1 (``whole``), is
+evaluated with its arrays whole (:func:`_whole_terms`).
 
 The per-twist terms come from :mod:`~fixplan.surface.point_kernel`,
 :mod:`~fixplan.surface.polygon_kernel`, :mod:`~fixplan.surface.grid_kernel` and
@@ -71,8 +71,19 @@ DISKS = 2
 BALL = 4
 # EDGES = 1 and NODES = 3: see fixplan.surface.closed_form.
 
-#: Where a kernel's facets ``(x, y, friction)`` start in its tuple (see the module).
-FACETS = 12
+#: Where a kernel's entries sit in its tuple (see the module): whether it is one part, unposed,
+#: of weight 1, that part's kind and far-field radius, the number of facets; the parts' table,
+#: the points' columns and the tables. (Few arrays: each array of a tuple costs about 10 ns per
+#: call between compiled functions that branch, in its reference counting, a tenth of a few
+#: points' terms; so does each view made of an array, so ranges are passed instead.)
+WHOLE, WHOLE_KIND, WHOLE_REACH, FACET_COUNT, PARTS, COLUMNS, TABLES = range(7)
+
+#: Columns of a kernel's parts table: kind, first and end point, first and end table column,
+#: weight, far-field radius, whether posed (1.0 or 0.0), then the transform (row by row).
+KIND, POINT_START, POINT_STOP, TABLE_START, TABLE_STOP, WEIGHT, REACH, POSED, TRANSFORM = range(9)
+
+#: Rows of the table of a kernel's parts: a polygon's edges have the most.
+TABLE_ROWS = 7
 
 #: Number of nearest support points whose facets are tested per query.
 FACETS_TESTED = 3
@@ -136,27 +147,31 @@ def _terms(kernel, eps2, twist, with_hessian, local, out):  # pragma: no cover -
     them (without the Hessian, ``out[4:]`` is left as it was); ``local`` (10,) is scratch.
     ``eps2`` [m²/s²] smooths the speeds of points. The parts' terms are summed, each at its
     local twist ``T V`` and weighed: ``g = w Tᵀ g_local``, ``H = w Tᵀ H_local T``."""
-    kinds, weights, transforms, posed = kernel[0], kernel[1], kernel[2], kernel[3]
-    if kinds.shape[0] == 1 and not posed[0] and weights[0] == 1.0:
-        _part_terms(kernel, 0, eps2, twist[0], twist[1], twist[2], with_hessian, out)
+    if kernel[WHOLE]:
+        _whole_terms(kernel, eps2, twist[0], twist[1], twist[2], with_hessian, out)
         return
+    parts = kernel[PARTS]
     last = 10 if with_hessian else 4
     for i in range(last):
         out[i] = 0.0
+    t = np.empty((3, 3))
     hl = np.empty((3, 3))
-    for part in range(kinds.shape[0]):
-        t = transforms[part]
+    for part in range(parts.shape[0]):
+        posed = parts[part, POSED] != 0.0
         vx, vy, w = twist[0], twist[1], twist[2]
-        if posed[part]:
+        if posed:
+            for i in range(3):
+                for j in range(3):
+                    t[i, j] = parts[part, TRANSFORM + 3 * i + j]
             vx, vy, w = (
                 t[0, 0] * twist[0] + t[0, 1] * twist[1] + t[0, 2] * twist[2],
                 t[1, 0] * twist[0] + t[1, 1] * twist[1] + t[1, 2] * twist[2],
                 t[2, 0] * twist[0] + t[2, 1] * twist[1] + t[2, 2] * twist[2],
             )
         _part_terms(kernel, part, eps2, vx, vy, w, with_hessian, local)
-        weight = weights[part]
+        weight = parts[part, WEIGHT]
         out[0] += weight * local[0]
-        if not posed[part]:
+        if not posed:
             for i in range(1, last):
                 out[i] += weight * local[i]
             continue
@@ -173,27 +188,38 @@ def _terms(kernel, eps2, twist, with_hessian, local, out):  # pragma: no cover -
             out[4 + slot] += weight * total
 
 
+def _whole_terms(kernel, eps2, vx, vy, w, with_hessian, out):  # pragma: no cover - compiled
+    """:func:`_terms` of a kernel of one part, unposed and of weight 1 (its arrays whole)."""
+    kind = kernel[WHOLE_KIND]
+    if kind == DISKS or (kind != POINTS and abs(w) * kernel[WHOLE_REACH] > math.hypot(vx, vy)):
+        _table_terms(kind, kernel[TABLES], vx, vy, w, with_hessian, out)
+    else:
+        columns = kernel[COLUMNS]
+        _POINT_TERMS(columns, 0, columns.shape[1], eps2, vx, vy, w, with_hessian, out)
+
+
 def _part_terms(kernel, part, eps2, vx, vy, w, with_hessian, out):  # pragma: no cover - compiled
     """:func:`_terms` of one ``part`` of the ``kernel`` at its local twist ``(vx, vy, w)``,
     unweighed."""
-    kinds, point_bounds, px, py, pw = kernel[0], kernel[4], kernel[5], kernel[6], kernel[7]
-    table_bounds, table_rows, tables, reach = kernel[8], kernel[9], kernel[10], kernel[11]
-    kind = kinds[part]
+    parts = kernel[PARTS]
+    kind = int(parts[part, KIND])
     if kind == BALL:
         _ball_terms(vx, vy, w, with_hessian, out)
         return
-    if kind != POINTS:
-        start, stop, rows = table_bounds[part], table_bounds[part + 1], table_rows[part]
-        table = tables[start:stop].reshape((rows, (stop - start) // rows))
-        if kind == DISKS:
-            _DISK_TERMS(table, vx, vy, w, with_hessian, out)
-            return
-        if abs(w) * reach[part] > math.sqrt(vx * vx + vy * vy):
-            _NEAR_TERMS(kind, table, vx, vy, w, with_hessian, out)
-            return
-    start, stop = point_bounds[part], point_bounds[part + 1]
-    _POINT_TERMS(px[start:stop], py[start:stop], pw[start:stop], eps2, vx, vy, w, with_hessian,
-                 out)  # fmt: skip
+    if kind == DISKS or (kind != POINTS and abs(w) * parts[part, REACH] > math.hypot(vx, vy)):
+        start, stop = int(parts[part, TABLE_START]), int(parts[part, TABLE_STOP])
+        _table_terms(kind, kernel[TABLES][:, start:stop], vx, vy, w, with_hessian, out)
+        return
+    start, stop = int(parts[part, POINT_START]), int(parts[part, POINT_STOP])
+    _POINT_TERMS(kernel[COLUMNS], start, stop, eps2, vx, vy, w, with_hessian, out)
+
+
+def _table_terms(kind, table, vx, vy, w, with_hessian, out):  # pragma: no cover - compiled
+    """The terms of a disk, polygon or grid ``table`` (rows beyond its own are padding)."""
+    if kind == DISKS:
+        _DISK_TERMS(table, vx, vy, w, with_hessian, out)
+    else:
+        _NEAR_TERMS(kind, table, vx, vy, w, with_hessian, out)
 
 
 def _ball_terms(vx, vy, w, with_hessian, out):  # pragma: no cover - compiled
@@ -329,14 +355,14 @@ def _slowest_point(kernel, twist):  # pragma: no cover - compiled
 def _slowest(kernel, twist, index, speed):  # pragma: no cover - compiled
     """Indices ``index`` (n,) of the points with the least weighted speed under ``twist``, and
     those speeds ``|v_i| * weight_i`` in ``speed``, slowest first."""
-    px, py, pw = kernel[FACETS:]
+    points = kernel[COLUMNS]
     count = index.shape[0]
     speed[:] = np.inf
     index[:] = -1
-    for i in range(px.shape[0]):
-        ux = twist[0] - twist[2] * py[i]
-        uy = twist[1] + twist[2] * px[i]
-        s = math.sqrt(ux * ux + uy * uy) * pw[i]
+    for i in range(kernel[FACET_COUNT]):
+        ux = twist[0] - twist[2] * points[1, i]
+        uy = twist[1] + twist[2] * points[0, i]
+        s = math.sqrt(ux * ux + uy * uy) * points[2, i]
         if s < speed[count - 1]:
             j = count - 1
             while j > 0 and s < speed[j - 1]:
@@ -352,8 +378,8 @@ def _facet(kernel, load, scale, k, twist, with_hessian, terms):  # pragma: no co
     does not lie on it (the force point ``k`` must carry to balance it is above its friction
     limit), NaN where the facet is parallel to the load. The facet's twist (on the plane
     ``L·V = 1``) is left in ``twist`` and the terms of the other points there in ``terms``."""
-    px, py, pw = kernel[FACETS:]
-    twist[0], twist[1], twist[2] = py[k], -px[k], 1.0
+    points = kernel[COLUMNS]
+    twist[0], twist[1], twist[2] = points[1, k], -points[0, k], 1.0
     power = load[0] * twist[0] + load[1] * twist[1] + load[2]
     if power == 0.0:
         return np.nan
@@ -362,13 +388,13 @@ def _facet(kernel, load, scale, k, twist, with_hessian, terms):  # pragma: no co
     _terms(kernel, 0.0, twist, with_hessian, local, terms)
     s_k = scale * terms[0]
     carried = math.hypot(s_k * load[0] - scale * terms[1], s_k * load[1] - scale * terms[2])
-    return s_k if carried <= scale * pw[k] * (1.0 + FACET_RTOL) else np.inf
+    return s_k if carried <= scale * points[2, k] * (1.0 + FACET_RTOL) else np.inf
 
 
 def _facets(kernel, load, scale, twist, safety):  # pragma: no cover - compiled
     """The safety factor on the facets of the slowest support points where ``load`` lies on
     one (``twist`` is then set to the facet's twist), else ``safety``; and whether it does."""
-    count = min(FACETS_TESTED, kernel[FACETS].shape[0])
+    count = min(FACETS_TESTED, kernel[FACET_COUNT])
     index = np.empty(count, dtype=np.int64)
     speed = np.empty(count)
     _slowest(kernel, twist, index, speed)
@@ -387,18 +413,19 @@ def _facets(kernel, load, scale, twist, safety):  # pragma: no cover - compiled
 def _nearest_kink(kernel, twist, step):  # pragma: no cover - compiled
     """The support point that comes nearest to standing still (least weighted speed) on the
     segment from ``twist`` to ``twist + step``: the kink a rejected Newton step crosses."""
-    px, py, pw = kernel[FACETS:]
+    points = kernel[COLUMNS]
     best = np.inf
     nearest = 0
-    for i in range(px.shape[0]):
-        ux = twist[0] - twist[2] * py[i]
-        uy = twist[1] + twist[2] * px[i]
-        dx = step[0] - step[2] * py[i]
-        dy = step[1] + step[2] * px[i]
+    for i in range(kernel[FACET_COUNT]):
+        x, y, weight = points[0, i], points[1, i], points[2, i]
+        ux = twist[0] - twist[2] * y
+        uy = twist[1] + twist[2] * x
+        dx = step[0] - step[2] * y
+        dy = step[1] + step[2] * x
         t = min(max(-(ux * dx + uy * dy) / (dx * dx + dy * dy), 0.0), 1.0)
         ex = ux + t * dx
         ey = uy + t * dy
-        speed = (ex * ex + ey * ey) * pw[i] * pw[i]
+        speed = (ex * ex + ey * ey) * weight * weight
         if speed < best:
             best = speed
             nearest = i
@@ -434,18 +461,19 @@ def _escape_kink(kernel, twist, b1, b2, k, facet, rest):  # pragma: no cover - c
     ``h(F) - r |g_u| + w_k r + r² dᵀHd / 2``, least at ``r = (|g_u| - w_k) / dᵀHd``: a start
     on the smooth side of the kink, from which Newton converges quadratically.
     """
-    px, py, pw = kernel[FACETS:]
-    m00 = b1[0] - b1[2] * py[k]
-    m10 = b1[1] + b1[2] * px[k]
-    m01 = b2[0] - b2[2] * py[k]
-    m11 = b2[1] + b2[2] * px[k]
+    points = kernel[COLUMNS]
+    x, y, weight = points[0, k], points[1, k], points[2, k]
+    m00 = b1[0] - b1[2] * y
+    m10 = b1[1] + b1[2] * x
+    m01 = b2[0] - b2[2] * y
+    m11 = b2[1] + b2[2] * x
     det = m00 * m11 - m01 * m10
     g1 = rest[1] * b1[0] + rest[2] * b1[1] + rest[3] * b1[2]
     g2 = rest[1] * b2[0] + rest[2] * b2[1] + rest[3] * b2[2]
     gu0 = (m11 * g1 - m10 * g2) / det
     gu1 = (-m01 * g1 + m00 * g2) / det
     pull = math.hypot(gu0, gu1)
-    if not pull > pw[k]:
+    if not pull > weight:
         return 0.0
     # Plane direction δ = M⁻¹ û with û = -g_u / |g_u|.
     d0 = -(m11 * gu0 - m01 * gu1) / (det * pull)
@@ -459,7 +487,7 @@ def _escape_kink(kernel, twist, b1, b2, k, facet, rest):  # pragma: no cover - c
             curvature += d[i] * hess[i, j] * d[j]
     if not (curvature > 0.0 and math.isfinite(curvature)):
         return 0.0
-    distance = (pull - pw[k]) / curvature
+    distance = (pull - weight) / curvature
     start = facet + distance * d
     current = np.empty(10)
     near = distance * math.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2) <= NEAR_FACET * math.sqrt(
@@ -481,7 +509,6 @@ def _terms_near_facet(kernel, k, facet, rest, hess, twist, out):  # pragma: no c
     cubed, which :func:`_escape_kink` takes at about 1e-7 of the twist near the facets of 4,096
     points), point ``k``'s exactly. Saves a pass over the points (one of about seven of such a
     query), as Newton's first step from ``twist`` needs these terms only."""
-    px, py, pw = kernel[FACETS:]
     step = np.empty(3)
     moved = np.zeros(3)
     for i in range(3):
@@ -495,8 +522,7 @@ def _terms_near_facet(kernel, k, facet, rest, hess, twist, out):  # pragma: no c
         out[1 + i] = rest[1 + i] + moved[i]
     out[4:] = rest[4:]
     own = np.empty(10)
-    _POINT_TERMS(px[k : k + 1], py[k : k + 1], pw[k : k + 1], 0.0, twist[0], twist[1], twist[2],
-                 True, own)  # fmt: skip
+    _POINT_TERMS(kernel[COLUMNS], k, k + 1, 0.0, twist[0], twist[1], twist[2], True, own)
     for i in range(10):
         out[i] += own[i]
 
@@ -715,8 +741,10 @@ def _hessians(kernel, twists, out):  # pragma: no cover - compiled
         _unpack(terms, out[k])
 
 
-_ball_terms = compiled_scalar(_ball_terms)
-_part_terms = compiled_scalar(_part_terms)
+_ball_terms = compiled_scalar(_ball_terms, inline=True)
+_table_terms = compiled_scalar(_table_terms, inline=True)
+_part_terms = compiled_scalar(_part_terms, inline=True)
+_whole_terms = compiled_scalar(_whole_terms, inline=True)
 _terms = compiled_scalar(_terms)
 _unpack = compiled_scalar(_unpack)
 _supports = compiled_scalar(_supports)
@@ -855,27 +883,29 @@ def compile_kernel(kernel: SupportKernel) -> CompiledKernel | None:
         facets = (points[:, 0].copy(), points[:, 1].copy(), np.array(friction, dtype=float))
         parts.insert(0, (POINTS, 1.0, np.eye(3), *facets, _NO_TABLE, 0.0, len(friction)))
     else:
-        facets = (np.empty(0), np.empty(0), np.empty(0))
+        facets = (_NO_POINTS,) * 3
     kinds, weights, transforms, xs, ys, ws, tables, reach, work = zip(*parts, strict=True)
-    table = (
-        np.array(kinds, dtype=np.int64),
-        np.array(weights, dtype=float),
-        np.array(transforms, dtype=float).reshape(-1, 3, 3),
-        np.array([not np.array_equal(t, np.eye(3)) for t in transforms]),
-        _bounds([len(x) for x in xs]),
-        np.concatenate(xs),
-        np.concatenate(ys),
-        np.concatenate(ws),
-        _bounds([t.size for t in tables]),
-        np.array([t.shape[0] for t in tables], dtype=np.int64),
-        np.concatenate([t.ravel() for t in tables]),
-        np.array(reach, dtype=float),
-    )
-    return CompiledKernel(parts=(*table, *facets), discrete=discrete, work=sum(work))
+    table = np.zeros((len(parts), TRANSFORM + 9))
+    table[:, KIND] = kinds
+    table[:, POINT_STOP] = np.cumsum([len(x) for x in xs])
+    table[1:, POINT_START] = table[:-1, POINT_STOP]
+    table[:, TABLE_STOP] = np.cumsum([t.shape[1] for t in tables])
+    table[1:, TABLE_START] = table[:-1, TABLE_STOP]
+    table[:, WEIGHT] = weights
+    table[:, REACH] = reach
+    table[:, POSED] = [not np.array_equal(t, np.eye(3)) for t in transforms]
+    table[:, TRANSFORM:] = np.array(transforms, dtype=float).reshape(-1, 9)
+    padded = np.zeros((TABLE_ROWS, int(table[-1, TABLE_STOP])))
+    for start, part in zip(table[:, TABLE_START].astype(int), tables, strict=True):
+        padded[: part.shape[0], start : start + part.shape[1]] = part
+    whole = len(parts) == 1 and not table[0, POSED] and weights[0] == 1.0
+    columns = np.vstack([np.concatenate(xs), np.concatenate(ys), np.concatenate(ws)])
+    kernel_tuple = (whole, int(kinds[0]), float(reach[0]), len(facets[0]), table, columns, padded)
+    return CompiledKernel(parts=kernel_tuple, discrete=discrete, work=sum(work))
 
 
 #: The table of a part without one (points, an ellipsoid).
-_NO_TABLE = np.empty((1, 0))
+_NO_TABLE = np.empty((TABLE_ROWS, 0))
 _NO_POINTS = np.empty(0)
 
 
@@ -894,7 +924,7 @@ def _flatten(kernel: SupportKernel, transform: np.ndarray, weight: float, out: l
         if kernel.smoothing != 0.0:
             return False
         if not kernel.discrete:
-            columns = _point_columns(kernel)
+            columns = tuple(kernel.columns)
             out.append((POINTS, weight, transform, *columns, _NO_TABLE, 0.0, len(columns[0])))
         return True
     disks = _disk_table(kernel)
@@ -905,7 +935,7 @@ def _flatten(kernel: SupportKernel, transform: np.ndarray, weight: float, out: l
     if isinstance(kernel, ClosedFormKernel):
         table = np.array(kernel.table, dtype=float)
         reach = FAR_FIELD_RADII * kernel.size
-        columns = _point_columns(kernel.far)
+        columns = tuple(kernel.far.columns)
         out.append((kernel._KIND, weight, transform, *columns, table, reach, kernel.work))
         return True
     if isinstance(kernel, EllipsoidKernel):
@@ -914,11 +944,6 @@ def _flatten(kernel: SupportKernel, transform: np.ndarray, weight: float, out: l
         out.append((BALL, weight, factor @ transform, *(_NO_POINTS,) * 3, _NO_TABLE, 0.0, 1))
         return True
     return False
-
-
-def _bounds(sizes: list[int]) -> np.ndarray:
-    """Where each part's entries start in a concatenation of ``sizes``, and the end."""
-    return np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
 
 
 def _disk_table(kernel: SupportKernel) -> np.ndarray | None:
@@ -932,14 +957,3 @@ def _disk_table(kernel: SupportKernel) -> np.ndarray | None:
     else:
         return None
     return np.array(disks, dtype=float).T.copy()
-
-
-def _point_columns(kernel: PointSetKernel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Copies (writable, contiguous: every kernel then has the same numba types, compiled once)
-    of the points' x, y [m] and weights."""
-    points = np.asarray(kernel.points, dtype=float)
-    return (
-        np.array(points[:, 0], dtype=float),
-        np.array(points[:, 1], dtype=float),
-        np.array(kernel.weights, dtype=float),
-    )

@@ -27,9 +27,12 @@ STATIONARY_RTOL = 1e-12
 _JIT = {"fastmath": {"reassoc", "contract"}, "nogil": True, "error_model": "numpy"}
 
 
-def point_terms(px, py, pw, eps2, vx, vy, w, with_hessian, out):  # pragma: no cover - compiled
-    """Support value, gradient and (``with_hessian``) Hessian at one twist ``(vx, vy, w)``,
-    written to ``out`` ``(10,)``: ``h``, ``g`` (3), then ``H`` 00, 01, 02, 11, 12, 22.
+def point_terms(points, start, stop, eps2, vx, vy, w, with_hessian, out):  # pragma: no cover
+    """Support value, gradient and (``with_hessian``) Hessian at one twist ``(vx, vy, w)`` of the
+    points ``start`` to ``stop`` of the columns ``points`` ``(3, P)`` (``x``, ``y`` [m], weight;
+    a range rather than a view: a view costs as much as the terms of a few points, in its
+    reference counting), written to ``out`` ``(10,)``: ``h``, ``g`` (3), then ``H`` 00, 01, 02,
+    11, 12, 22.
 
     With ``s = sqrt(|u|² + eps²)``, ``A = [[1, 0, -y], [0, 1, x]]`` and ``e = u / s``:
     ``ds/dV = Aᵀ e``, ``d²s/dV² = Aᵀ (I - e eᵀ) A / s``. The loops are free of branches (a
@@ -42,14 +45,14 @@ def point_terms(px, py, pw, eps2, vx, vy, w, with_hessian, out):  # pragma: no c
     g1 = 0.0
     g2 = 0.0
     if not with_hessian:
-        for i in range(px.shape[0]):
-            x = px[i]
-            y = py[i]
+        for i in range(start, stop):
+            x = points[0, i]
+            y = points[1, i]
             ux = vx - w * y
             uy = vy + w * x
             speed = math.sqrt(ux * ux + uy * uy + eps2)
             moving = speed > STATIONARY_RTOL * (base + spin * (abs(x) + abs(y)))
-            c = pw[i] / speed if moving else 0.0
+            c = points[2, i] / speed if moving else 0.0
             gx = c * ux
             gy = c * uy
             h += c * speed * speed
@@ -67,15 +70,15 @@ def point_terms(px, py, pw, eps2, vx, vy, w, with_hessian, out):  # pragma: no c
     h11 = 0.0
     h12 = 0.0
     h22 = 0.0
-    for i in range(px.shape[0]):
-        x = px[i]
-        y = py[i]
+    for i in range(start, stop):
+        x = points[0, i]
+        y = points[1, i]
         ux = vx - w * y
         uy = vy + w * x
         speed = math.sqrt(ux * ux + uy * uy + eps2)
         moving = speed > STATIONARY_RTOL * (base + spin * (abs(x) + abs(y)))
         inverse = 1.0 / speed if moving else 0.0
-        c = pw[i] * inverse
+        c = points[2, i] * inverse
         gx = c * ux
         gy = c * uy
         h += c * speed * speed
@@ -107,20 +110,22 @@ def point_terms(px, py, pw, eps2, vx, vy, w, with_hessian, out):  # pragma: no c
     out[9] = h22
 
 
-def _evaluate(px, py, pw, eps2, twists, out_h, out_loads):  # pragma: no cover - compiled
+def _evaluate(points, eps2, twists, out_h, out_loads):  # pragma: no cover - compiled
+    count = points.shape[1]
     for k in numba.prange(twists.shape[0]):
         out = np.empty(10)
-        _POINT_TERMS(px, py, pw, eps2, twists[k, 0], twists[k, 1], twists[k, 2], False, out)
+        _POINT_TERMS(points, 0, count, eps2, twists[k, 0], twists[k, 1], twists[k, 2], False, out)
         out_h[k] = out[0]
         out_loads[k, 0] = out[1]
         out_loads[k, 1] = out[2]
         out_loads[k, 2] = out[3]
 
 
-def _newton_terms(px, py, pw, eps2, twists, out_h, out_g, out_hess):  # pragma: no cover
+def _newton_terms(points, eps2, twists, out_h, out_g, out_hess):  # pragma: no cover
+    count = points.shape[1]
     for k in numba.prange(twists.shape[0]):
         out = np.empty(10)
-        _POINT_TERMS(px, py, pw, eps2, twists[k, 0], twists[k, 1], twists[k, 2], True, out)
+        _POINT_TERMS(points, 0, count, eps2, twists[k, 0], twists[k, 1], twists[k, 2], True, out)
         out_h[k] = out[0]
         out_g[k, 0] = out[1]
         out_g[k, 1] = out[2]
@@ -244,14 +249,14 @@ class PointSetKernel(SupportKernel):
     weights: np.ndarray
     discrete: bool = False
     smoothing: float = 0.0
-    _x: np.ndarray = field(init=False, repr=False)
-    _y: np.ndarray = field(init=False, repr=False)
+    #: ``(3, n)``: the points' x, y [m] and weights, as the compiled terms read them.
+    columns: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self):
         points = np.asarray(self.points, dtype=float)
         object.__setattr__(self, "weights", np.ascontiguousarray(self.weights, dtype=float))
-        object.__setattr__(self, "_x", np.ascontiguousarray(points[:, 0]))
-        object.__setattr__(self, "_y", np.ascontiguousarray(points[:, 1]))
+        columns = np.vstack([points[:, 0], points[:, 1], self.weights])
+        object.__setattr__(self, "columns", columns)
 
     @property
     def size(self) -> float:
@@ -267,8 +272,8 @@ class PointSetKernel(SupportKernel):
         twists = np.ascontiguousarray(twists, dtype=float)
         h = np.empty(len(twists))
         loads = np.empty((len(twists), 3))
-        _pick(_EVALUATE, len(twists), len(self._x))(
-            self._x, self._y, self.weights, self.smoothing**2, twists, h, loads
+        _pick(_EVALUATE, len(twists), len(self.weights))(
+            self.columns, self.smoothing**2, twists, h, loads
         )
         return h, loads
 
@@ -277,8 +282,8 @@ class PointSetKernel(SupportKernel):
         h = np.empty(len(twists))
         g = np.empty((len(twists), 3))
         hess = np.empty((len(twists), 3, 3))
-        _pick(_NEWTON_TERMS, len(twists), len(self._x))(
-            self._x, self._y, self.weights, self.smoothing**2, twists, h, g, hess
+        _pick(_NEWTON_TERMS, len(twists), len(self.weights))(
+            self.columns, self.smoothing**2, twists, h, g, hess
         )
         return h, g, hess
 
