@@ -117,6 +117,7 @@ class LimitSurface:
         "_rho",
         "_scale",
         "_shape",
+        "_twist_scales",
         "_units",
         "field",
     )
@@ -150,6 +151,8 @@ class LimitSurface:
     ) -> None:
         self._kernel = kernel
         self._compiled = compile_kernel(kernel)
+        #: What bounds a twist's size in :meth:`_normalized` (the kernel's size is computed).
+        self._twist_scales = np.array([1.0, 1.0, kernel.size])
         self._scale = scale
         self._shape = shape
         probe = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
@@ -298,7 +301,7 @@ class LimitSurface:
         The kernels square speeds: twists far from unit size (beyond about 1e±154) would
         underflow or overflow there, though the load is homogeneous of degree 0 in the twist,
         the support of degree 1 and its Hessian of degree -1."""
-        return _binary_scaled(twists, np.array([1.0, 1.0, self._kernel.size]))
+        return _binary_scaled(twists, self._twist_scales)
 
     def _trusted_support(self, twists: np.ndarray) -> np.ndarray:
         """:meth:`support` ``(K,)`` of finite twists ``(K, 3)`` from a caller that checked them
