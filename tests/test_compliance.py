@@ -6,6 +6,8 @@ import warnings
 import numpy as np
 import pytest
 
+from fixplan import LimitSurface
+from fixplan.models import Exact
 from fixplan.motion.compliance import ComplianceError, Stiffness, analyse
 from fixplan.planner.problem import Body, Contact, Load, Problem
 from fixplan.surface import pressure
@@ -424,21 +426,36 @@ def test_an_unknown_seating_is_refused():
         analyse(problem, None, stiffness=stiffness, seating="tapped")
 
 
+#: Point supports of exact pads (their facets: no ellipsoid osculates there).
+PINS = pressure.points([[-0.005, 0.0], [0.005, 0.0], [0.0, 0.006]])
+
+
+def _with_patches(problem, make):
+    """``problem`` with each exact contact's patch (or model) replaced by ``make(contact)``."""
+    contacts = [make(c) if c.model == "exact" else c for c in problem.contacts]
+    return dataclasses.replace(problem, contacts=tuple(contacts))
+
+
+@pytest.mark.parametrize("pads", ["disks", "point supports"])
 @pytest.mark.parametrize(
     ("force", "point", "torque"),
     [([3.0, 1.0, 0.0], [0.2, 0.1, 0.0], 0.0), ([-1.0, 2.0, 0.0], [0.0, 0.3, 0.0], 0.4)],
 )
-def test_exact_pads_move_at_the_rigid_exact_safety_factor(force, point, torque):
-    """Exact pads, stated in each step by ellipsoids that osculate their exact sets: with the
-    normal forces fixed by statics the part moves at the rigid planner's exact safety factor
-    (4.0e-8 and 1.3e-8 off, the collapse bracketed to 1e-7; stated by the seed polytopes they
-    came out 6.6 % and 7.2 % above it), and no warning is given."""
+def test_exact_pads_move_at_the_rigid_exact_safety_factor(pads, force, point, torque):
+    """Exact pads, stated in each step by ellipsoids that osculate their exact sets (disks) or
+    by a cone per point (point supports): with the normal forces fixed by statics the part
+    moves at the rigid planner's exact safety factor (disks 4.0e-8 and 1.3e-8 off, the collapse
+    bracketed to 1e-7; stated by the seed polytopes they came out 6.6 % and 7.2 % above it;
+    point supports 5.5e-8 and 1.0e-8 off, 6.9 % and 6.0 % above it by their seed polytopes),
+    and no warning is given."""
     from fixplan.planner.planner import Planner
 
     load = Load(
         name="mill", force=np.array(force), point=np.array(point), torque=np.array([0, 0, torque])
     )
     problem = _pressed_plate("exact", load)
+    if pads == "point supports":
+        problem = _with_patches(problem, lambda c: dataclasses.replace(c, patch=PINS))
     stiffness = {
         "s1": Stiffness(normal=1e7, tangential=3e6, torsional=20.0),
         "s2": Stiffness(normal=4e7, tangential=1e6, torsional=5.0),
@@ -453,16 +470,18 @@ def test_exact_pads_move_at_the_rigid_exact_safety_factor(force, point, torque):
     assert result.first_slip["mill"] <= result.collapse["mill"]
 
 
-def test_exact_models_with_facets_warn_that_the_steps_state_their_seed_polytopes():
-    """Exact pads of point supports have no osculating ellipsoid at their facets: the steps
-    state their seed polytopes, and the analysis says so."""
+def test_exact_models_of_point_supports_beside_patches_warn_of_their_seed_polytopes():
+    """An exact model of point supports and a patch together has neither an osculating
+    ellipsoid at its facets nor a cone per point for its patch: the steps state its seed
+    polytope, and the analysis says so."""
     load = Load(name="mill", force=np.array([3.0, 1.0, 0.0]), point=np.array([0.2, 0.1, 0.0]))
-    problem = _pressed_plate("exact", load)
-    pins = pressure.points([[-0.005, 0.0], [0.005, 0.0], [0.0, 0.006]])
-    contacts = [dataclasses.replace(c, patch=pins) if c.model == "exact" else c
-                for c in problem.contacts]  # fmt: skip
-    problem = dataclasses.replace(problem, contacts=tuple(contacts))
-    with pytest.warns(UserWarning, match=r"s1, s2, s3 have facets .* seed polytopes"):
+    both = LimitSurface.combine([LimitSurface(PINS, mu=0.4), LimitSurface(pressure.disk(0.004),
+                                                                           mu=0.4)])  # fmt: skip
+    problem = _with_patches(
+        _pressed_plate("exact", load),
+        lambda c: dataclasses.replace(c, model=Exact.from_limit_surface(both), patch=None),
+    )
+    with pytest.warns(UserWarning, match=r"s1, s2, s3 have point supports beside patches"):
         analyse(problem, None, stiffness=Stiffness(normal=1e7, tangential=3e6, torsional=20.0))
 
 

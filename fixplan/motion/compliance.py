@@ -53,9 +53,10 @@ Each step is the minimum of the complementary energy of the springs, a convex pr
 
 An ``exact`` friction model is stated in a step by the ellipsoid that osculates its exact set
 where the step's friction load meets it, moved until the step is the exact set's (see
-:class:`~fixplan.motion.contact_springs.ContactQP`). One with facets (point supports), where no
-ellipsoid osculates, is stated by its seed polytope (24 tangent planes, which hold the exact
-set): its sliding friction can lie outside the exact set, and a warning says so.
+:class:`~fixplan.motion.contact_springs.ContactQP`). One on point supports, where no ellipsoid
+osculates at the facets, is stated exactly by a cone per point. One of point supports and
+patches together is stated by its seed polytope (24 tangent planes, which hold the exact set):
+its sliding friction can lie outside the exact set, and a warning says so.
 """
 
 from __future__ import annotations
@@ -81,6 +82,7 @@ from fixplan.motion.load_ramp import LoadRamp, State
 from fixplan.planner.contact_models import contact_models
 from fixplan.planner.osculating_contact import osculates
 from fixplan.planner.plan import Plan
+from fixplan.planner.point_support_contact import on_point_supports
 from fixplan.planner.problem import PASSIVE_ROLES, Contact, Problem
 from fixplan.tolerances import MAX_SAFETY_FACTOR
 
@@ -287,15 +289,16 @@ def analyse(
 
 
 def _warn_of_exact_models(names, models) -> None:
-    """Warn where contacts with friction have exact models with facets: the steps state their
-    seed polytopes (see the module doc)."""
+    """Warn where contacts with friction have exact models of point supports and patches
+    together: the steps state their seed polytopes (see the module doc)."""
     exact = [(n, m) for n, m in zip(names, models, strict=True)
-             if isinstance(m, Exact) and not m.frictionless and not osculates(m)]  # fmt: skip
+             if isinstance(m, Exact) and not m.frictionless and not osculates(m)
+             and not on_point_supports(m)]  # fmt: skip
     if exact:
         gap = max(m.constraint_error for _, m in exact)
         warnings.warn(
             f"compliant analysis: the exact friction models of {', '.join(n for n, _ in exact)} "
-            f"have facets (point supports) and are stated by their seed polytopes, up to "
+            f"have point supports beside patches and are stated by their seed polytopes, up to "
             f"{gap:.1%} outside the exact sets: the first slip is exact, but a sliding "
             "contact's friction can exceed its exact set and the collapse come out too large",
             stacklevel=3,

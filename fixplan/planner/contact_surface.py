@@ -34,6 +34,7 @@ from fixplan.planner.osculating_contact import (
     OsculatingContact,
     osculates,
 )
+from fixplan.planner.point_support_contact import on_point_supports, point_support_constraints
 from fixplan.planner.problem import Contact
 from fixplan.surface import pressure
 from fixplan.surface.geometry import Pose
@@ -270,8 +271,9 @@ class _ConicPrograms:
     the ellipsoid that osculates its exact set where its load meets it, solved again with the
     ellipsoids moved until it is the exact problem
     (:class:`~fixplan.planner.osculating_contact.OsculatingContact`); the motion is then its
-    multipliers. An exact contact with facets (point supports) is stated by its seed polytope,
-    which holds its exact set.
+    multipliers. An exact contact on point supports is stated exactly, a cone per point
+    (:mod:`~fixplan.planner.point_support_contact`); one of point supports and patches together
+    by its seed polytope, which holds its exact set.
     """
 
     def __init__(self, contacts, models, forces, subspace):
@@ -288,7 +290,7 @@ class _ConicPrograms:
             for i, (model, fn) in enumerate(zip(models, forces, strict=True))
             if isinstance(model, Exact) and fn > 0.0 and not model.frictionless
         }
-        #: Their ellipsoids in the gauge, but for those with facets (their seed polytopes).
+        #: Their ellipsoids in the gauge, but for those with facets (see the class).
         self._ellipsoids = {
             i: OsculatingContact(model) for i, (model, _) in self._exact.items() if osculates(model)
         }
@@ -297,7 +299,10 @@ class _ConicPrograms:
             if i in self._ellipsoids:
                 constraints.append(self._ellipsoids[i].constraint(load, float(fn)))
                 continue
-            rows = model.constraints(load, float(fn))
+            if on_point_supports(model):
+                rows = point_support_constraints(model, load, float(fn))
+            else:
+                rows = model.constraints(load, float(fn))
             constraints += rows
             if i not in self._exact:
                 others += rows
