@@ -43,6 +43,11 @@ FRICTION_SET_RTOL = 1e-6
 #: excess (``1 / s - 1``) in a plan: the planner adds tangent-plane cuts until they do.
 EXACT_CUT_RTOL = 1e-9
 
+#: Exact sets stated as convex constraints (point supports, a cone per point) are shrunk by this
+#: fraction, so that a solver's feasibility error (about 1e-9) leaves no load outside the exact
+#: set by more than ``EXACT_CUT_RTOL`` (as the planner's cuts and ellipsoids are tightened).
+STATED_SET_MARGIN = 1e-8
+
 #: Fixed-force objectives cap each load scale here; a case that reaches the cap is reported with
 #: an infinite safety factor (held at any practical multiple). A higher cap makes the conic
 #: problems badly scaled (reactions a million times the loads).

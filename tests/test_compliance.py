@@ -446,7 +446,7 @@ def test_exact_pads_move_at_the_rigid_exact_safety_factor(pads, force, point, to
     by a cone per point (point supports): with the normal forces fixed by statics the part
     moves at the rigid planner's exact safety factor (disks 4.0e-8 and 1.3e-8 off, the collapse
     bracketed to 1e-7; stated by the seed polytopes they came out 6.6 % and 7.2 % above it;
-    point supports 5.5e-8 and 1.0e-8 off, 6.9 % and 6.0 % above it by their seed polytopes),
+    point supports 5.7e-8 and 4.6e-9 off, 6.9 % and 6.0 % above it by their seed polytopes),
     and no warning is given."""
     from fixplan.planner.planner import Planner
 

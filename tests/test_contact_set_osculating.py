@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from fixplan import Contact, ContactSetSurface, pressure
+from fixplan.tolerances import STATED_SET_MARGIN
 
 #: The rotation taking y to z (and z to -y): fingers along y become contacts from below and above.
 TURN = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
@@ -41,10 +42,10 @@ def fingers(turned: bool, patches: str = "patches") -> list[Contact]:
 def test_exact_fingers_off_the_plane_are_held_to_their_exact_sets(patches):
     """In the subspace (fx, fz, my) the fingers' set is that of the turned fingers in (fx, fy,
     mz) with fy = -fz: an exact LimitSurface. Patches: their loads are held inside their exact
-    sets to 1e-9 by osculating ellipsoids; point supports: stated exactly, a cone per point.
-    Safety factors are within 2e-9 of the exact form (seen: patches 5.4e-10 on 40 random
-    loads; point supports 1.5e-9 on those and 20 next to their facets, where their seed
-    polytopes were up to 33 % above it), the motions, the program's multipliers, within 2e-5 in normalised
+    sets to 1e-9 by osculating ellipsoids; point supports: stated exactly, a cone per point,
+    shrunk by 1e-8. Safety factors are within 2e-9 of the exact form for patches (seen: 5.4e-10
+    on 40 random loads) and 1e-8 to 1.2e-8 below it for point supports (on those and 20 next to
+    their facets, where their seed polytopes were up to 33 % above it), the motions, the program's multipliers, within 2e-5 in normalised
     coordinates ``(v, rho w)`` (patches 4.7e-6 at most, median 7.6e-7; point supports 2.2e-5
     at most, next to a facet, median 2.5e-6); supports are the surfaces' sums."""
     across = ContactSetSurface(fingers(False, patches), FORCES, ("fx", "fz", "my"))
@@ -60,7 +61,8 @@ def test_exact_fingers_off_the_plane_are_held_to_their_exact_sets(patches):
     for load in rng.normal(size=(15, 3)) * [12.0, 12.0, 0.16]:
         motion, safety = across.motion_and_safety_factor(load)
         expected_motion, expected = flat.motion_and_safety_factor(load * flip)
-        assert safety == pytest.approx(expected, rel=2e-9)
+        shrunk = 0.0 if patches == "patches" else STATED_SET_MARGIN
+        assert safety == pytest.approx(expected * (1.0 - shrunk), rel=2e-9)
         np.testing.assert_allclose(unit(motion * flip), unit(expected_motion), rtol=0, atol=2e-5)
     for twist in rng.normal(size=(10, 3)):
         assert across.support(twist) == pytest.approx(flat.support(twist * flip), rel=1e-14)

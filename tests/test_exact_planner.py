@@ -320,8 +320,12 @@ def test_an_infeasible_exact_problem_is_certified_by_the_cutting_planes():
     assert (problem.objective, False) in planner._runner._built
 
 
-def test_point_supports_take_the_cutting_planes():
-    # Facets have no curvature to osculate.
+def test_few_point_supports_are_stated_exactly_and_many_take_the_cutting_planes(monkeypatch):
+    """Facets have no curvature to osculate. Up to ``MAX_STATED_POINTS`` point supports are
+    stated exactly, a cone per point: one solve, whose optimum is that of the cutting planes on
+    the same supports (where they are more than that) to 1e-7 (seen: 1.5e-9)."""
+    from fixplan.models import exact
+
     patch = pressure.points([[0.01, 0.0], [-0.01, 0.0], [0.0, 0.01]], [1.0, 1.0, 1.0])
     contacts = [
         Contact(name=name, role="finger", position=[0, side * HALF_GAP, 0], normal=[0, -side, 0],
@@ -331,12 +335,15 @@ def test_point_supports_take_the_cutting_planes():
     load = Load(name="hold", force=[0, 0, -10.0], point=[0, 0, 0], torque=[0, 0.05, 0])
     problem = Problem(body=Body(mass=0.0, center_of_mass=[0, 0, 0]), contacts=contacts,
                       loads=[load], objective="min-max-normal-force")  # fmt: skip
-    planner = Planner(problem)
-    assert not planner._runner.osculating
-    plan = planner.solve()
-    assert plan.status == "optimal"
-    assert plan.solver == "CLARABEL (cutting planes)"
-    assert_loads_inside_their_exact_surfaces(problem, plan)
+    plans = {}
+    for most, solver in ((3, "CLARABEL"), (2, "CLARABEL (cutting planes)")):
+        monkeypatch.setattr(exact, "MAX_STATED_POINTS", most)
+        planner = Planner(problem)
+        assert not planner._runner.osculating
+        plans[most] = plan = planner.solve()
+        assert plan.status == "optimal" and plan.solver == solver
+        assert_loads_inside_their_exact_surfaces(problem, plan)
+    assert plans[3].objective_value == pytest.approx(plans[2].objective_value, rel=1e-7)
 
 
 def test_the_uses_kept_from_the_last_cutting_round_are_those_of_the_final_loads():

@@ -35,6 +35,7 @@ from fixplan.models.conic import unit_conic
 from fixplan.models.ellipsoid import surface_units
 from fixplan.surface.point_kernel import compiled_scalar
 from fixplan.surface.sphere import fibonacci_sphere
+from fixplan.tolerances import STATED_SET_MARGIN
 
 if TYPE_CHECKING:  # pragma: no cover
     from fixplan.surface.limit_surface import LimitSurface
@@ -42,6 +43,17 @@ if TYPE_CHECKING:  # pragma: no cover
 #: Tangent planes of the seed polytope (mirror pairs of a Fibonacci lattice of twists in
 #: normalised coordinates). More planes: fewer cutting rounds in the planner, larger problems.
 SEED_PLANES = 24
+
+#: Point supports up to this many are stated exactly, a cone per point (:attr:`Exact.stated_exactly`);
+#: more take the seed polytope and the planner's cuts: each point adds a cone and two variables
+#: per contact and load case. On the fixture of benchmarks/bench_planner.py (8 contacts x 20
+#: milling loads) a re-solve stated exactly took 14, 32 and 242 ms on 3, 9 and 64 points per
+#: pad against 400, 383 and 336 ms by the cuts, on 256 points 1,085 ms against 333 ms.
+MAX_STATED_POINTS = 64
+
+#: Point supports are the whole surface where their friction is its largest force to this
+#: fraction (a pure translation moves every point alike).
+WHOLE_FRICTION_RTOL = 1e-12
 
 
 @dataclass(frozen=True, slots=True, kw_only=True, repr=False, eq=False)
@@ -58,6 +70,7 @@ class Exact(FrictionModel):
     surface: LimitSurface
     _seed: np.ndarray = dataclasses.field(init=False)
     _unit_scale: np.ndarray = dataclasses.field(init=False)  # (see _units)
+    _points: tuple | None = dataclasses.field(init=False)  # (see stated_exactly)
 
     conservative: ClassVar[bool] = True
 
@@ -74,6 +87,7 @@ class Exact(FrictionModel):
         seed = np.vstack([directions, -directions]) / np.concatenate([support, support])[:, None]
         seed.setflags(write=False)
         object.__setattr__(self, "_seed", seed)
+        object.__setattr__(self, "_points", _whole_point_supports(self.surface))
 
     def _units(self) -> np.ndarray:
         """:meth:`FrictionModel._units`, computed once (read-only): the planner's rounds ask
@@ -109,9 +123,22 @@ class Exact(FrictionModel):
         return Exact(surface=self.surface.friction_shape)
 
     @property
+    def stated_exactly(self) -> bool:
+        r"""Whether :meth:`constraints` state the exact set: a surface of at most
+        ``MAX_STATED_POINTS`` point supports alone (or none with friction), whose set at normal
+        force ``N`` is the sum of the points' friction disks (paper §4.4), a cone per point:
+        ``ℓ = Σ_i (f_i, x_i f_{i,y} - y_i f_{i,x})`` with ``|f_i| <= c_i N`` (``c_i`` the
+        point's friction per unit normal force), shrunk by ``STATED_SET_MARGIN`` (1e-8) so that
+        a solver's loads lie inside it. Otherwise they state the seed polytope, which holds it."""
+        return self.frictionless or self._points is not None
+
+    @property
     def constraint_error(self) -> float:
-        """Largest relative radial gap of the seed polytope (:meth:`constraints`) to the exact
-        surface [-], read at the polytope's vertices (the polytope holds the surface)."""
+        """Largest relative radial gap of the set :meth:`constraints` state to the exact surface
+        [-]: 0 where :attr:`stated_exactly`, else the seed polytope's, read at its vertices (the
+        polytope holds the surface)."""
+        if self.stated_exactly:
+            return 0.0
         from scipy.spatial import ConvexHull
 
         hull = ConvexHull(self._seed)
@@ -241,8 +268,28 @@ class Exact(FrictionModel):
         return twists * self._units()
 
     def _unit_conic(self):
+        if self._points is not None:
+            return self._point_supports_conic()
         count = len(self._seed)
         return unit_conic(np.ones(count), -self._seed, cones=[("nonneg", count)])
+
+    def _point_supports_conic(self):
+        """The exact set of point supports (:attr:`stated_exactly`) in normalised coordinates:
+        three rows ``ℓ(q) - Σ_i A_i f_i = 0``, then a cone ``(c_i N, f_i)`` per point, the
+        forces ``f_i`` [N] the auxiliary variables."""
+        (x, y), per_force = self._points
+        count = len(per_force)
+        normal = np.zeros(3 + 3 * count)
+        load = np.zeros((3 + 3 * count, 3))
+        aux = np.zeros((3 + 3 * count, 2 * count))
+        load[:3] = np.linalg.inv(self._normalising_map())  # (the rows take the load ℓ)
+        aux[0, 0::2], aux[1, 1::2] = -1.0, -1.0
+        aux[2, 0::2], aux[2, 1::2] = y, -x
+        first = 3 + 3 * np.arange(count)
+        normal[first] = per_force / (1.0 + STATED_SET_MARGIN)
+        aux[first + 1, 0::2] = np.eye(count)
+        aux[first + 2, 1::2] = np.eye(count)
+        return unit_conic(normal, load, aux, cones=[("zero", 3)] + [("soc", 3)] * count)
 
     def __repr__(self) -> str:
         return (
@@ -341,3 +388,18 @@ _OSCULATING_FACTOR = compiled_scalar(osculating_factor, inline=True)
 
 _OSCULATING_FACTORS = compiled_scalar(osculating_factors)
 _RAY_OSCULATION = compiled_scalar(ray_osculation)
+
+
+def _whole_point_supports(surface: LimitSurface) -> tuple | None:
+    """The point supports of ``surface`` as ``((x, y), friction per unit normal force)`` where
+    they are all of its friction and at most ``MAX_STATED_POINTS`` (see
+    :attr:`Exact.stated_exactly`), else ``None``."""
+    if surface.frictionless:
+        return None
+    points, friction = surface.point_supports
+    whole = surface.max_force
+    if not 0 < len(friction) <= MAX_STATED_POINTS:
+        return None
+    if abs(float(friction.sum()) - whole) > WHOLE_FRICTION_RTOL * whole:
+        return None
+    return (points[:, 0].copy(), points[:, 1].copy()), friction / surface.normal_force

@@ -82,7 +82,6 @@ from fixplan.motion.load_ramp import LoadRamp, State
 from fixplan.planner.contact_models import contact_models
 from fixplan.planner.osculating_contact import osculates
 from fixplan.planner.plan import Plan
-from fixplan.planner.point_support_contact import on_point_supports
 from fixplan.planner.problem import PASSIVE_ROLES, Contact, Problem
 from fixplan.tolerances import MAX_SAFETY_FACTOR
 
@@ -293,7 +292,7 @@ def _warn_of_exact_models(names, models) -> None:
     together: the steps state their seed polytopes (see the module doc)."""
     exact = [(n, m) for n, m in zip(names, models, strict=True)
              if isinstance(m, Exact) and not m.frictionless and not osculates(m)
-             and not on_point_supports(m)]  # fmt: skip
+             and not m.stated_exactly]  # fmt: skip
     if exact:
         gap = max(m.constraint_error for _, m in exact)
         warnings.warn(

@@ -28,7 +28,7 @@ each solve until every exact contact's load is inside its exact set and, where i
 holds it back, on the exact surface with the ellipsoid's normal there the exact surface's: there
 the step meets the exact problem's optimality conditions (sequential convex programming with exact second-order models, as the
 planner's rounds, :mod:`fixplan.planner.osculating`). One on point supports is stated exactly,
-a cone per point (:mod:`~fixplan.planner.point_support_contact`); one of point supports and
+a cone per point (:attr:`~fixplan.models.Exact.stated_exactly`); one of point supports and
 patches together keeps its seed polytope.
 :class:`SpringSystem` solves purely elastic steps exactly: the QP (with unlimited friction,
 except none at lifted contacts) tells which contacts touch, and with that set fixed the step is
@@ -52,7 +52,6 @@ from fixplan.planner.osculating_contact import (
     osculates,
 )
 from fixplan.planner.parameters import assign
-from fixplan.planner.point_support_contact import on_point_supports, point_support_constraints
 
 #: A polished solution is accepted when its equilibrium residual, negative normal forces and
 #: closed gaps of lifted contacts are below this fraction of the step's force scale.
@@ -153,8 +152,6 @@ class ContactQP:
             if osculates(model):
                 self._osculating[i] = OsculatingContact(model)
                 constraints.append(self._osculating[i].constraint(load, self.bound[i]))
-            elif on_point_supports(model):
-                constraints += point_support_constraints(model, load, self.bound[i])
             else:
                 constraints += model.constraints(load, self.bound[i])
         self._forces = forces

@@ -34,7 +34,6 @@ from fixplan.planner.osculating_contact import (
     OsculatingContact,
     osculates,
 )
-from fixplan.planner.point_support_contact import on_point_supports, point_support_constraints
 from fixplan.planner.problem import Contact
 from fixplan.surface import pressure
 from fixplan.surface.geometry import Pose
@@ -271,8 +270,8 @@ class _ConicPrograms:
     the ellipsoid that osculates its exact set where its load meets it, solved again with the
     ellipsoids moved until it is the exact problem
     (:class:`~fixplan.planner.osculating_contact.OsculatingContact`); the motion is then its
-    multipliers. An exact contact on point supports is stated exactly, a cone per point
-    (:mod:`~fixplan.planner.point_support_contact`); one of point supports and patches together
+    multipliers. An exact contact on point supports alone is stated exactly, a cone per point
+    (:attr:`~fixplan.models.Exact.stated_exactly`); one of point supports and patches together
     by its seed polytope, which holds its exact set.
     """
 
@@ -299,10 +298,7 @@ class _ConicPrograms:
             if i in self._ellipsoids:
                 constraints.append(self._ellipsoids[i].constraint(load, float(fn)))
                 continue
-            if on_point_supports(model):
-                rows = point_support_constraints(model, load, float(fn))
-            else:
-                rows = model.constraints(load, float(fn))
+            rows = model.constraints(load, float(fn))
             constraints += rows
             if i not in self._exact:
                 others += rows

@@ -88,7 +88,9 @@ class ExactContacts:
     @classmethod
     def of(cls, models, slices, normal, friction, **options):
         """The pool of the exact models among ``models`` (one per contact), or ``None``."""
-        exact = {i: m for i, m in enumerate(models) if isinstance(m, Exact) and not m.frictionless}
+        exact = {
+            i: m for i, m in enumerate(models) if isinstance(m, Exact) and not m.stated_exactly
+        }
         return cls(exact, slices, normal, friction, **options) if exact else None
 
     def _by_model(self, owner: np.ndarray):

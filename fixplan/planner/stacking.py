@@ -111,7 +111,8 @@ _NO_ROWS = ConicForm(normal=np.zeros(0), load=np.zeros((0, 3)), aux=np.zeros((0,
 
 
 def _exact(model: FrictionModel) -> bool:
-    return isinstance(model, Exact) and not model.frictionless
+    """Whether ``model`` is exact and its constraints hold its set only from outside."""
+    return isinstance(model, Exact) and not model.stated_exactly
 
 
 def _stack_cones(forms: list[ConicForm], starts, aux_starts) -> dict:
