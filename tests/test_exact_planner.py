@@ -346,6 +346,33 @@ def test_few_point_supports_are_stated_exactly_and_many_take_the_cutting_planes(
     assert plans[3].objective_value == pytest.approx(plans[2].objective_value, rel=1e-7)
 
 
+@pytest.mark.parametrize("torque", [0.0, 0.05, 0.2])
+def test_a_finger_on_point_supports_beside_a_smooth_one_keeps_the_osculating_ellipsoids(
+    monkeypatch, torque
+):
+    """A pinch between a disk and three point supports: the points stated exactly, the disk by
+    osculating ellipsoids, at the optimum of the cutting planes on both to 1e-7 (seen: 1.8e-9
+    to 7.5e-9)."""
+    from fixplan.models import exact
+
+    patches = (pressure.disk(R), pressure.points([[0.01, 0.0], [-0.01, 0.0], [0.0, 0.01]]))
+    contacts = [
+        Contact(name=name, role="finger", position=[0, side * HALF_GAP, 0], normal=[0, -side, 0],
+                mu=MU, model="exact", patch=patch)
+        for name, side, patch in zip(("left", "right"), (-1, 1), patches, strict=True)
+    ]  # fmt: skip
+    load = Load(name="hold", force=[0, 0, -10.0], point=[0.003, 0, 0], torque=[0, torque, 0.01])
+    problem = Problem(body=Body(mass=0.0, center_of_mass=[0, 0, 0]), contacts=contacts,
+                      loads=[load], objective="min-max-normal-force")  # fmt: skip
+    plan = Planner(problem).solve()
+    assert plan.status == "optimal" and plan.solver == "CLARABEL (osculating ellipsoids)"
+    assert_loads_inside_their_exact_surfaces(problem, plan)
+    monkeypatch.setattr(exact, "MAX_STATED_POINTS", 0)
+    cut = Planner(problem).solve()
+    assert cut.solver == "CLARABEL (cutting planes)"
+    assert plan.objective_value == pytest.approx(cut.objective_value, rel=1e-7)
+
+
 def test_the_uses_kept_from_the_last_cutting_round_are_those_of_the_final_loads():
     """Verification and the analysis take the exact contacts' friction use from the last round
     of cuts instead of asking the exact surfaces again: it must be that of the final loads."""
