@@ -1,8 +1,9 @@
 """The smallest box around a friction model's set, per unit normal force: an outer polyhedral
 approximation for the cheap feasibility test of :mod:`fixplan.design.prune`.
 
-The box is that of the set the planner states (the model's :meth:`conic_form`, an outer polytope
-for the exact model), so it contains every friction load the planner can use.
+The box is that of the set the planner states (the model's :meth:`conic_form`: for the exact model
+an outer polytope, or its exact set on point supports), so it contains every friction load the
+planner can use.
 """
 
 from __future__ import annotations

@@ -16,7 +16,8 @@ curvature on the ray of any load. The planner moves such ellipsoids
 (:mod:`fixplan.planner.osculating`) or adds such cuts (:mod:`fixplan.planner.cuts`) until every
 contact load lies inside its exact surface at the exact optimum; used on its own,
 :meth:`constraints` states the seed polytope only, which holds the exact set
-(:attr:`Exact.constraint_error` says by how much).
+(:attr:`Exact.constraint_error` says by how much), but on a few point supports alone, whose set
+it states exactly, a cone per point (:attr:`Exact.stated_exactly`).
 
 A frictionless contact keeps the shape of its patch (:attr:`LimitSurface.friction_shape`):
 its set is the load 0 and its motion the limit ``mu → 0+`` (:mod:`fixplan.models.base`).
