@@ -1,6 +1,7 @@
 """Fuzzed contact-set surfaces: one to four contacts of every friction model (exact patches of
-several shapes, ellipsoids, pyramids, point cones), with random places, normals (half of them
-along an axis) and normal forces, in the planar subspace or three random wrench components.
+several shapes and point supports, ellipsoids, pyramids, point cones), with random places,
+normals (half of them along an axis) and normal forces, in the planar subspace or three random
+wrench components.
 
 For five random loads each, checks that the safety factor ``s`` and motion ``V`` meet the
 normality law of the set's support function, ``h(V) = s d·V``, where ``s`` is above 1e-12 (flat
@@ -25,7 +26,9 @@ MODELS = ("exact", "exact", "ellipsoid", "point-cone", "pyramid")
 
 
 def _patch(rng):
-    kind = rng.integers(0, 3)
+    kind = rng.integers(0, 4)
+    if kind == 3:  # (point supports: an exact model states them exactly, a cone per point)
+        return pressure.points(rng.normal(size=(rng.integers(2, 6), 2)) * 0.01)
     if kind == 0:
         profile = ("uniform", "hertz", "parabolic")[rng.integers(0, 3)]
         return pressure.disk(rng.uniform(0.003, 0.02), profile)
