@@ -22,6 +22,7 @@ The machine is shared and noisy: compare the ratios of the same run.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import resource
 import subprocess
@@ -41,6 +42,9 @@ from performance_rows import emit
 
 #: Re-solves with new loads per problem and model (their median is reported).
 RESOLVES = 20
+
+#: Re-solves with new loads per way of stating point supports (:func:`point_support_figures`).
+POINT_RESOLVES = 8
 
 
 #: Evaluations and queries timed per kind of centre of rotation on the grid alone.
@@ -171,6 +175,54 @@ def grid_figures(cells: int) -> None:
         )
 
 
+def point_support_figures() -> None:
+    """The fixture with every patch point supports (3, 9, 64 and 256 per pad): re-solves with the
+    exact model stating them exactly (a cone per point, whatever ``MAX_STATED_POINTS`` says)
+    against the cutting planes on the same supports (``MAX_STATED_POINTS`` set to 0), in the
+    same process, and how far apart their optima are: where the first is faster is where the
+    model states them by default."""
+    from fixplan.models import exact
+
+    print("fixture, 8 contacts x 20 milling loads, every patch point supports (exact model)")
+    stated = exact.MAX_STATED_POINTS
+    for side in (None, 3, 8, 16):
+        if side is None:
+            patch = pressure.points([[0.006, 0.0], [-0.003, 0.005], [-0.003, -0.005]])
+        else:
+            grid = [[x, y] for x in np.linspace(-0.01, 0.01, side)
+                    for y in np.linspace(-0.005, 0.005, side)]  # fmt: skip
+            patch = pressure.points(grid)
+        count = len(patch.xy)
+        base = fixture("exact", "min-total-clamp-force", milling_loads(20, 1))
+        contacts = tuple(dataclasses.replace(c, patch=patch) for c in base.contacts)
+        problem = dataclasses.replace(base, contacts=contacts)
+        times, values = {}, {}
+        for way, most in (("stated", count), ("cuts", 0)):
+            exact.MAX_STATED_POINTS = most
+            planner = Planner(problem)
+            planner.solve()
+            found, spent = [], []
+            for seed in range(2, 2 + POINT_RESOLVES):
+                start = time.perf_counter()
+                found.append(planner.solve(milling_loads(20, seed)).objective_value)
+                spent.append(time.perf_counter() - start)
+            times[way], values[way] = float(np.median(spent)) * 1e3, np.array(found)
+        exact.MAX_STATED_POINTS = stated
+        gap = float(np.max(np.abs(values["stated"] / values["cuts"] - 1.0)))
+        ratio = times["cuts"] / times["stated"]
+        default = "stated" if count <= stated else "cutting planes"
+        print(f"  {count:3d} points per pad: re-solve {times['stated']:.1f} ms stated exactly, "
+              f"{times['cuts']:.1f} ms by cutting planes: x{ratio:.1f}; optima within {gap:.1e} "
+              f"(by default: {default})")  # fmt: skip
+        emit(
+            f"exact model on point supports, fixture (8 contacts × 20 milling loads), {count} "
+            "points per pad: re-solve stated exactly (a cone per point)",
+            f"{times['stated']:,.1f} ms",
+            f"cutting planes {times['cuts']:,.1f} ms (optima within {gap:.0e})",
+            f"{ratio:.1f}× faster" if ratio >= 1.0 else f"{1.0 / ratio:.1f}× slower",
+        )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--cells", type=int, default=200, help="grid side of the pinch")
@@ -180,6 +232,7 @@ def main() -> None:
         print(json.dumps(measure(*args.child, args.cells)))
         return
     grid_figures(args.cells)
+    point_support_figures()
     for case, title in (
         ("pinch", f"pinch, 2 tactile grids of {args.cells} x {args.cells} cells, 4 load cases"),
         ("fixture", "fixture, 8 area contacts x 20 milling loads (bench_planner.py)"),
