@@ -291,8 +291,7 @@ def _warn_of_exact_models(names, models) -> None:
     """Warn where contacts with friction have exact models of point supports and patches
     together: the steps state their seed polytopes (see the module doc)."""
     exact = [(n, m) for n, m in zip(names, models, strict=True)
-             if isinstance(m, Exact) and not m.frictionless and not osculates(m)
-             and not m.stated_exactly]  # fmt: skip
+             if isinstance(m, Exact) and not osculates(m) and not m.stated_exactly]  # fmt: skip
     if exact:
         gap = max(m.constraint_error for _, m in exact)
         warnings.warn(

@@ -142,8 +142,9 @@ MARGIN = 1e-8
 
 
 def smooth(models) -> bool:
-    """Whether every exact model among ``models`` has a smooth set (no facets), so that the
-    osculating ellipsoids apply; ``False`` without exact models."""
+    """Whether every exact model among ``models`` whose constraints hold its set only from
+    outside (not :attr:`~fixplan.models.Exact.stated_exactly`) has a smooth set (no facets), so
+    that the osculating ellipsoids apply; ``False`` without such models."""
     exact = [m for m in models if isinstance(m, Exact) and not m.stated_exactly]
     return bool(exact) and not any(m.surface.has_facets for m in exact)
 

@@ -76,9 +76,9 @@ _FAR_ORDER = 12
 _CHUNK = 4096
 
 #: Up to this many twists, the support function (and the load) is evaluated by the compiled
-#: kernel one twist at a time (a Hertz disk: 1.8 µs for 2 twists and 14 µs for 64, against 49 and 59 µs of the
-#: NumPy kernel; a rectangle: 1.9 and 19 µs against 2.8 and 25 µs); larger batches take the
-#: vectorised NumPy kernels.
+#: kernel one twist at a time (a Hertz disk: 1.8 µs for 2 twists and 14 µs for 64, against 49
+#: and 59 µs of the NumPy kernel; a rectangle: 1.9 and 19 µs against 2.8 and 25 µs); larger
+#: batches take the vectorised NumPy kernels.
 COMPILED_SUPPORT_MAX_TWISTS = 64
 
 _PLANES = {"fx-m": (0, 2), "fy-m": (1, 2), "fx-fy": (0, 1)}
@@ -151,7 +151,8 @@ class LimitSurface:
     ) -> None:
         self._kernel = kernel
         self._compiled = compile_kernel(kernel)
-        #: What bounds a twist's size in :meth:`_normalized` (the kernel's size is computed).
+        #: What bounds a twist's size in :meth:`_normalized` (kept: a kernel computes its size
+        #: at each call, a third of a slide's forward map on a contact set).
         self._twist_scales = np.array([1.0, 1.0, kernel.size])
         self._scale = scale
         self._shape = shape
