@@ -470,18 +470,30 @@ def test_exact_pads_move_at_the_rigid_exact_safety_factor(pads, force, point, to
     assert result.first_slip["mill"] <= result.collapse["mill"]
 
 
-def test_exact_models_of_point_supports_beside_patches_warn_of_their_seed_polytopes():
-    """An exact model of point supports and a patch together has neither an osculating
-    ellipsoid at its facets nor a cone per point for its patch: the steps state its seed
-    polytope, and the analysis says so."""
+def _many_points():
+    """An exact model of 8 x 9 point supports: more than the model states a cone for each."""
+    grid = [[x, y] for x in np.linspace(-0.005, 0.005, 8) for y in np.linspace(-0.004, 0.004, 9)]
+    return Exact.from_limit_surface(LimitSurface(pressure.points(grid), mu=0.4))
+
+
+def _beside_a_patch():
+    """An exact model of point supports and a patch together."""
+    both = [LimitSurface(PINS, mu=0.4), LimitSurface(pressure.disk(0.004), mu=0.4)]
+    return Exact.from_limit_surface(LimitSurface.combine(both))
+
+
+@pytest.mark.parametrize("model", [_beside_a_patch, _many_points])
+def test_exact_models_with_facets_not_stated_exactly_warn_of_their_seed_polytopes(model):
+    """Point supports beside a patch (neither an osculating ellipsoid at the facets nor a cone
+    per point for the patch), or more of them than ``MAX_STATED_POINTS``: the steps state their
+    seed polytopes, and the analysis says so."""
     load = Load(name="mill", force=np.array([3.0, 1.0, 0.0]), point=np.array([0.2, 0.1, 0.0]))
-    both = LimitSurface.combine([LimitSurface(PINS, mu=0.4), LimitSurface(pressure.disk(0.004),
-                                                                           mu=0.4)])  # fmt: skip
+    exact = model()
+    assert not exact.stated_exactly
     problem = _with_patches(
-        _pressed_plate("exact", load),
-        lambda c: dataclasses.replace(c, model=Exact.from_limit_surface(both), patch=None),
+        _pressed_plate("exact", load), lambda c: dataclasses.replace(c, model=exact, patch=None)
     )
-    with pytest.warns(UserWarning, match=r"s1, s2, s3 have point supports beside patches"):
+    with pytest.warns(UserWarning, match=r"s1, s2, s3 have facets \(point supports beside a "):
         analyse(problem, None, stiffness=Stiffness(normal=1e7, tangential=3e6, torsional=20.0))
 
 

@@ -45,9 +45,10 @@ def test_exact_fingers_off_the_plane_are_held_to_their_exact_sets(patches):
     sets to 1e-9 by osculating ellipsoids; point supports: stated exactly, a cone per point,
     shrunk by 1e-8. Safety factors are within 2e-9 of the exact form for patches (seen: 5.4e-10
     on 40 random loads) and 1e-8 to 1.2e-8 below it for point supports (on those and 20 next to
-    their facets, where their seed polytopes were up to 33 % above it), the motions, the program's multipliers, within 2e-5 in normalised
-    coordinates ``(v, rho w)`` (patches 4.7e-6 at most, median 7.6e-7; point supports 2.2e-5
-    at most, next to a facet, median 2.5e-6); supports are the surfaces' sums."""
+    their facets, where their seed polytopes were up to 33 % above it), the motions, the
+    program's multipliers, within 2e-5 in normalised coordinates ``(v, rho w)`` (patches 4.7e-6
+    at most, median 7.6e-7; point supports 2.2e-5 at most, next to a facet, median 2.5e-6);
+    supports are the surfaces' sums."""
     across = ContactSetSurface(fingers(False, patches), FORCES, ("fx", "fz", "my"))
     flat = ContactSetSurface(fingers(True, patches), FORCES, ("fx", "fy", "mz"))
     assert across.as_limit_surface() is None and flat.as_limit_surface() is not None

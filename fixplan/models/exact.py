@@ -47,10 +47,10 @@ SEED_PLANES = 24
 
 #: Point supports up to this many are stated exactly, a cone per point
 #: (:attr:`Exact.stated_exactly`); more take the seed polytope and the planner's cuts: each point
-#: adds a cone and two variables per contact and load case. On the fixture of benchmarks/bench_planner.py (8 contacts x 20
-#: milling loads; benchmarks/bench_exact.py) a re-solve stated exactly took 15, 33 and 233 ms on
-#: 3, 9 and 64 points per pad against 400, 390 and 376 ms by the cuts, on 256 points 1,090 ms
-#: against 374 ms.
+#: adds a cone and two variables per contact and load case. On the fixture of
+#: benchmarks/bench_planner.py (8 contacts x 20 milling loads; benchmarks/bench_exact.py) a
+#: re-solve stated exactly took 15, 33 and 233 ms on 3, 9 and 64 points per pad against 400, 390
+#: and 376 ms by the cuts, on 256 points 1,090 ms against 374 ms.
 MAX_STATED_POINTS = 64
 
 #: Point supports are the whole surface where their friction is its largest force to this

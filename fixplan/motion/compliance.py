@@ -54,9 +54,10 @@ Each step is the minimum of the complementary energy of the springs, a convex pr
 An ``exact`` friction model is stated in a step by the ellipsoid that osculates its exact set
 where the step's friction load meets it, moved until the step is the exact set's (see
 :class:`~fixplan.motion.contact_springs.ContactQP`). One on point supports, where no ellipsoid
-osculates at the facets, is stated exactly by a cone per point. One of point supports and
-patches together is stated by its seed polytope (24 tangent planes, which hold the exact set):
-its sliding friction can lie outside the exact set, and a warning says so.
+osculates at the facets, is stated exactly by a cone per point. Other sets with facets (point
+supports beside a patch, or more than ``MAX_STATED_POINTS`` of them) are stated by their seed
+polytopes (24 tangent planes, which hold the exact set): their sliding friction can lie outside
+the exact set, and a warning says so.
 """
 
 from __future__ import annotations
@@ -70,6 +71,7 @@ import numpy as np
 from fixplan import validation
 from fixplan.errors import InvalidArgumentError
 from fixplan.models import Exact
+from fixplan.models.exact import MAX_STATED_POINTS
 from fixplan.motion.contact_springs import (
     ComplianceError,
     ContactQP,
@@ -288,15 +290,16 @@ def analyse(
 
 
 def _warn_of_exact_models(names, models) -> None:
-    """Warn where contacts with friction have exact models of point supports and patches
-    together: the steps state their seed polytopes (see the module doc)."""
+    """Warn where contacts with friction have exact models with facets that the steps state
+    by their seed polytopes (see the module doc)."""
     exact = [(n, m) for n, m in zip(names, models, strict=True)
              if isinstance(m, Exact) and not osculates(m) and not m.stated_exactly]  # fmt: skip
     if exact:
         gap = max(m.constraint_error for _, m in exact)
         warnings.warn(
             f"compliant analysis: the exact friction models of {', '.join(n for n, _ in exact)} "
-            f"have point supports beside patches and are stated by their seed polytopes, up to "
+            f"have facets (point supports beside a patch, or more than {MAX_STATED_POINTS} of "
+            f"them) and are stated by their seed polytopes, up to "
             f"{gap:.1%} outside the exact sets: the first slip is exact, but a sliding "
             "contact's friction can exceed its exact set and the collapse come out too large",
             stacklevel=3,

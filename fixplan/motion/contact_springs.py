@@ -26,10 +26,10 @@ solves it with Clarabel. An exact friction model's set is stated by an ellipsoid
 :meth:`~fixplan.models.Exact.osculating`) where the ray of the step's load meets it, moved after
 each solve until every exact contact's load is inside its exact set and, where its ellipsoid
 holds it back, on the exact surface with the ellipsoid's normal there the exact surface's: there
-the step meets the exact problem's optimality conditions (sequential convex programming with exact second-order models, as the
-planner's rounds, :mod:`fixplan.planner.osculating`). One on point supports is stated exactly,
-a cone per point (:attr:`~fixplan.models.Exact.stated_exactly`); one of point supports and
-patches together keeps its seed polytope.
+the step meets the exact problem's optimality conditions (sequential convex programming with
+exact second-order models, as the planner's rounds, :mod:`fixplan.planner.osculating`). One on
+point supports is stated exactly, a cone per point (:attr:`~fixplan.models.Exact.stated_exactly`);
+other sets with facets (point supports beside a patch, or very many) keep their seed polytopes.
 :class:`SpringSystem` solves purely elastic steps exactly: the QP (with unlimited friction,
 except none at lifted contacts) tells which contacts touch, and with that set fixed the step is
 linear,

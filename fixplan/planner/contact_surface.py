@@ -111,8 +111,9 @@ class ContactSetSurface:
         patch's exact surface at its normal force) or an :class:`~fixplan.models.Ellipsoid` or
         :class:`~fixplan.models.FittedEllipsoid` (its ellipsoid, :meth:`LimitSurface.ellipsoid`),
         a patch's placed in the plane by its frame (mirrored where the normal is ``-z``); a
-        patch, or point contacts in two or more places. ``None`` otherwise. Where it exists, the queries of this class ask it (exact, and no
-        conic solve per call), and so do the sliding dynamics and pushing trajectories, which
+        patch, or point contacts in two or more places. ``None`` otherwise. Where it exists,
+        the queries of this class ask it (exact, and no conic solve per call), and so do the
+        sliding dynamics and pushing trajectories, which
         follow a part turning about one of its points as such (the conic programs' friction at
         a point at rest is any of its disk). Its point supports are the point contacts' with
         friction and the patches', those at one place merged into one: the indices of
@@ -265,14 +266,14 @@ class _ConicPrograms:
     queried with DPP problems compiled once (Clarabel).
 
     The support function of the sum is the sum of the contacts' supports: the exact contacts'
-    from their exact surfaces (facets included), the others' from one conic solve. The gauge of a direction (its
-    safety factor) is one conic problem over all contacts, each smooth exact contact stated by
-    the ellipsoid that osculates its exact set where its load meets it, solved again with the
-    ellipsoids moved until it is the exact problem
+    from their exact surfaces (facets included), the others' from one conic solve. The gauge of
+    a direction (its safety factor) is one conic problem over all contacts, each smooth exact
+    contact stated by the ellipsoid that osculates its exact set where its load meets it, solved
+    again with the ellipsoids moved until it is the exact problem
     (:class:`~fixplan.planner.osculating_contact.OsculatingContact`); the motion is then its
     multipliers. An exact contact on point supports alone is stated exactly, a cone per point
-    (:attr:`~fixplan.models.Exact.stated_exactly`); one of point supports and patches together
-    by its seed polytope, which holds its exact set.
+    (:attr:`~fixplan.models.Exact.stated_exactly`); other sets with facets (point supports
+    beside a patch, or very many) by their seed polytopes, which hold them.
     """
 
     def __init__(self, contacts, models, forces, subspace):

@@ -17,6 +17,12 @@ from fixplan.models.exact import Exact
 from fixplan.planner.parameters import assign, part_values
 
 
+def takes_rounds(model) -> bool:
+    """Whether ``model`` is an exact model whose constraints hold its set only from outside
+    (not :attr:`~fixplan.models.Exact.stated_exactly`): cuts or ellipsoids bring its loads in."""
+    return isinstance(model, Exact) and not model.stated_exactly
+
+
 class ExactContacts:
     """The exact contacts of a stacked problem, and their cut rows.
 
@@ -88,9 +94,7 @@ class ExactContacts:
     @classmethod
     def of(cls, models, slices, normal, friction, **options):
         """The pool of the exact models among ``models`` (one per contact), or ``None``."""
-        exact = {
-            i: m for i, m in enumerate(models) if isinstance(m, Exact) and not m.stated_exactly
-        }
+        exact = {i: m for i, m in enumerate(models) if takes_rounds(m)}
         return cls(exact, slices, normal, friction, **options) if exact else None
 
     def _by_model(self, owner: np.ndarray):

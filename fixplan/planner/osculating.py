@@ -40,8 +40,7 @@ from collections.abc import Callable
 import cvxpy as cp
 import numpy as np
 
-from fixplan.models.exact import Exact
-from fixplan.planner.exact_contacts import ExactContacts
+from fixplan.planner.exact_contacts import ExactContacts, takes_rounds
 from fixplan.planner.osculating_steps import SETTLE, SOLVED_PAIRS, pair_buffers
 from fixplan.planner.parameters import assign
 from fixplan.tolerances import (
@@ -145,7 +144,7 @@ def smooth(models) -> bool:
     """Whether every exact model among ``models`` whose constraints hold its set only from
     outside (not :attr:`~fixplan.models.Exact.stated_exactly`) has a smooth set (no facets), so
     that the osculating ellipsoids apply; ``False`` without such models."""
-    exact = [m for m in models if isinstance(m, Exact) and not m.stated_exactly]
+    exact = [m for m in models if takes_rounds(m)]
     return bool(exact) and not any(m.surface.has_facets for m in exact)
 
 

@@ -26,8 +26,8 @@ import scipy.sparse as sp
 
 from fixplan.models.base import FrictionModel
 from fixplan.models.conic import ConicForm, soc_columns
-from fixplan.models.exact import Exact
 from fixplan.planner.cuts import CutPool
+from fixplan.planner.exact_contacts import takes_rounds
 from fixplan.planner.objectives import objective_expression
 from fixplan.planner.osculating import OsculatingPool
 from fixplan.planner.parameters import assign, part_values
@@ -84,7 +84,8 @@ class ContactLayout:
         bases = [contact.wrench_basis() for contact in problem.contacts]
         starts = np.concatenate([[0], np.cumsum(dims)])
         slices = tuple(slice(int(a), int(b)) for a, b in itertools.pairwise(starts))
-        elsewhere = [osculating and _exact(model) for model in models]  # an ellipsoid bounds N
+        # (Exact sets stated by ellipsoids, which bound the normal force.)
+        elsewhere = [osculating and takes_rounds(model) for model in models]
         forms = [
             _NO_ROWS if e else model.conic_form()
             for e, model in zip(elsewhere, models, strict=True)
@@ -108,11 +109,6 @@ class ContactLayout:
 
 #: The form of a contact whose set is stated elsewhere (an osculating ellipsoid).
 _NO_ROWS = ConicForm(normal=np.zeros(0), load=np.zeros((0, 3)), aux=np.zeros((0, 0)), cones=())
-
-
-def _exact(model: FrictionModel) -> bool:
-    """Whether ``model`` is exact and its constraints hold its set only from outside."""
-    return isinstance(model, Exact) and not model.stated_exactly
 
 
 def _stack_cones(forms: list[ConicForm], starts, aux_starts) -> dict:

@@ -867,6 +867,11 @@ def not_converged(load: np.ndarray, relative_gradient: float) -> ConvergenceErro
 DISK_WORK = 64
 
 
+#: The table of a part without one (points, an ellipsoid).
+_NO_TABLE = np.empty((TABLE_ROWS, 0))
+_NO_POINTS = np.empty(0)
+
+
 def compile_kernel(kernel: SupportKernel) -> CompiledKernel | None:
     """The compiled form of a point-set, polygon, grid, disk or ellipsoid kernel, or of a sum
     of them, posed or not (``None`` where any part is another kernel: those take the NumPy
@@ -902,11 +907,6 @@ def compile_kernel(kernel: SupportKernel) -> CompiledKernel | None:
     columns = np.vstack([np.concatenate(xs), np.concatenate(ys), np.concatenate(ws)])
     kernel_tuple = (whole, int(kinds[0]), float(reach[0]), len(facets[0]), table, columns, padded)
     return CompiledKernel(parts=kernel_tuple, discrete=discrete, work=sum(work))
-
-
-#: The table of a part without one (points, an ellipsoid).
-_NO_TABLE = np.empty((TABLE_ROWS, 0))
-_NO_POINTS = np.empty(0)
 
 
 def _flatten(kernel: SupportKernel, transform: np.ndarray, weight: float, out: list) -> bool:
